@@ -1,0 +1,61 @@
+#include "core/config.hpp"
+
+#include <yaml-cpp/yaml.h>
+
+namespace adit {
+namespace {
+
+void flatten(const YAML::Node& node, const std::string& prefix, std::map<std::string, std::string>& out) {
+  const auto join = [&](const std::string& k) { return prefix.empty() ? k : prefix + "." + k; };
+  switch (node.Type()) {
+    case YAML::NodeType::Map:
+      for (const auto& kv : node) flatten(kv.second, join(kv.first.as<std::string>()), out);
+      break;
+    case YAML::NodeType::Sequence:
+      for (std::size_t i = 0; i < node.size(); ++i) flatten(node[i], join(std::to_string(i)), out);
+      break;
+    case YAML::NodeType::Scalar:
+      out[prefix] = node.as<std::string>();
+      break;
+    default:
+      break;  // null: leave the default in force
+  }
+}
+
+}  // namespace
+
+Config Config::fromYamlString(const std::string& text) {
+  Config c;
+  try {
+    flatten(YAML::Load(text), "", c.values_);
+  } catch (const YAML::Exception& e) {
+    throw std::runtime_error(std::string("config: invalid YAML: ") + e.what());
+  }
+  return c;
+}
+
+Config Config::fromYamlFile(const std::string& path) {
+  Config c;
+  try {
+    flatten(YAML::LoadFile(path), "", c.values_);
+  } catch (const YAML::BadFile&) {
+    throw std::runtime_error("config: cannot read '" + path + "'");
+  } catch (const YAML::Exception& e) {
+    throw std::runtime_error("config: invalid YAML in '" + path + "': " + e.what());
+  }
+  return c;
+}
+
+Config Config::section(const std::string& prefix) const {
+  Config c;
+  const std::string p = prefix + ".";
+  for (auto it = values_.lower_bound(p); it != values_.end() && it->first.compare(0, p.size(), p) == 0; ++it)
+    c.values_[it->first.substr(p.size())] = it->second;
+  return c;
+}
+
+void Config::merge(const Config& other) {
+  for (const auto& kv : other.values_) values_[kv.first] = kv.second;
+}
+
+}  // namespace adit

@@ -1,0 +1,66 @@
+// Configuration as a flat, ordered map of dotted keys ("odometry.max_iterations" -> "10"), read from YAML.
+// Stages take plain config structs; nodes fill them from a Config with documented defaults.
+#pragma once
+
+#include <map>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace adit {
+
+class Config {
+ public:
+  Config() = default;
+  // Throws std::runtime_error naming the file and the problem.
+  static Config fromYamlFile(const std::string& path);
+  static Config fromYamlString(const std::string& text);
+
+  // The keys under "prefix." with the prefix removed.
+  Config section(const std::string& prefix) const;
+  // Overlay: values of `other` replace ours.
+  void merge(const Config& other);
+
+  bool has(const std::string& key) const { return values_.count(key) > 0; }
+  void set(const std::string& key, const std::string& value) { values_[key] = value; }
+  const std::map<std::string, std::string>& values() const { return values_; }
+
+  // Typed read with a default; throws std::runtime_error if the value does not parse as T.
+  template <class T>
+  T get(const std::string& key, const T& fallback) const {
+    auto it = values_.find(key);
+    if (it == values_.end()) return fallback;
+    return parse<T>(key, it->second);
+  }
+  // A YAML sequence ("key: [1, 2, 3]") stored as key.0, key.1, ...
+  template <class T>
+  std::vector<T> getList(const std::string& key, const std::vector<T>& fallback) const {
+    if (!has(key + ".0")) return fallback;
+    std::vector<T> out;
+    for (int i = 0; has(key + "." + std::to_string(i)); ++i) out.push_back(get<T>(key + "." + std::to_string(i), T{}));
+    return out;
+  }
+
+ private:
+  template <class T>
+  static T parse(const std::string& key, const std::string& text) {
+    if constexpr (std::is_same_v<T, std::string>) {
+      return text;
+    } else if constexpr (std::is_same_v<T, bool>) {
+      if (text == "true" || text == "True" || text == "1" || text == "yes" || text == "on") return true;
+      if (text == "false" || text == "False" || text == "0" || text == "no" || text == "off") return false;
+      throw std::runtime_error("config: '" + key + "' = '" + text + "' is not a boolean");
+    } else {
+      std::istringstream in(text);
+      T value{};
+      in >> value;
+      if (in.fail() || !(in >> std::ws).eof())
+        throw std::runtime_error("config: '" + key + "' = '" + text + "' is not a valid number");
+      return value;
+    }
+  }
+  std::map<std::string, std::string> values_;
+};
+
+}  // namespace adit
