@@ -1,0 +1,235 @@
+#include "msg/convert.hpp"
+
+#include "core/geometry.hpp"
+
+#include <algorithm>
+
+namespace adit::msg {
+namespace {
+
+void copyMatrix6(const Matrix6d& m, double out[36]) {
+  for (int r = 0; r < 6; ++r)
+    for (int c = 0; c < 6; ++c) out[r * 6 + c] = m(r, c);
+}
+
+Matrix6d readMatrix6(const double in[36]) {
+  Matrix6d m;
+  for (int r = 0; r < 6; ++r)
+    for (int c = 0; c < 6; ++c) m(r, c) = in[r * 6 + c];
+  return m;
+}
+
+}  // namespace
+
+adit::header_t makeHeader(std::int64_t utime, const std::string& frame_id) {
+  adit::header_t h;
+  h.utime = utime;
+  h.seq = 0;
+  h.frame_id = frame_id;
+  return h;
+}
+
+adit::point_cloud_t toMessage(const std::vector<LidarPoint>& points, const LidarScan& like) {
+  adit::point_cloud_t m;
+  m.header = makeHeader(like.utime, "lidar");
+  m.header.seq = like.seq;
+  m.sensor = like.sensor;
+  m.num_beams = static_cast<std::int16_t>(like.num_beams);
+  m.sweep_duration = like.sweep_duration;
+  m.flags = (like.has_ring ? adit::point_cloud_t::FLAG_HAS_RING : 0) |
+            (like.has_time ? adit::point_cloud_t::FLAG_HAS_TIME : 0) |
+            (like.deskewed ? adit::point_cloud_t::FLAG_DESKEWED : 0);
+  const std::size_t n = points.size();
+  m.num_points = static_cast<std::int32_t>(n);
+  m.x.resize(n);
+  m.y.resize(n);
+  m.z.resize(n);
+  m.intensity.resize(n);
+  m.ring.resize(n);
+  m.dt.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const LidarPoint& p = points[i];
+    m.x[i] = p.p.x();
+    m.y[i] = p.p.y();
+    m.z[i] = p.p.z();
+    m.intensity[i] = p.intensity;
+    m.ring[i] = static_cast<std::int16_t>(p.ring);
+    m.dt[i] = p.dt;
+  }
+  return m;
+}
+
+adit::point_cloud_t toMessage(const LidarScan& scan) { return toMessage(scan.points, scan); }
+
+std::vector<LidarPoint> pointsFromMessage(const adit::point_cloud_t& m) {
+  // LCM guarantees every array has num_points entries once decoded.
+  const auto n = static_cast<std::size_t>(std::max(0, m.num_points));
+  std::vector<LidarPoint> points(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    LidarPoint& p = points[i];
+    p.p = Eigen::Vector3f(m.x[i], m.y[i], m.z[i]);
+    p.intensity = m.intensity[i];
+    p.ring = static_cast<std::uint16_t>(std::max<std::int16_t>(0, m.ring[i]));
+    p.dt = m.dt[i];
+  }
+  return points;
+}
+
+LidarScan fromMessage(const adit::point_cloud_t& m) {
+  LidarScan scan;
+  scan.utime = m.header.utime;
+  scan.seq = m.header.seq;
+  scan.sensor = m.sensor;
+  scan.num_beams = m.num_beams;
+  scan.sweep_duration = m.sweep_duration;
+  scan.has_ring = (m.flags & adit::point_cloud_t::FLAG_HAS_RING) != 0;
+  scan.has_time = (m.flags & adit::point_cloud_t::FLAG_HAS_TIME) != 0;
+  scan.deskewed = (m.flags & adit::point_cloud_t::FLAG_DESKEWED) != 0;
+  scan.points = pointsFromMessage(m);
+  return scan;
+}
+
+adit::imu_t toMessage(const ImuSample& imu) {
+  adit::imu_t m;
+  m.header = makeHeader(imu.utime, "imu");
+  for (int i = 0; i < 3; ++i) {
+    m.angular_velocity[i] = imu.gyro[i];
+    m.linear_acceleration[i] = imu.accel[i];
+    m.magnetic_field[i] = imu.magnetic_field ? (*imu.magnetic_field)[i] : 0.0;
+  }
+  const Eigen::Quaterniond q = imu.orientation.value_or(Eigen::Quaterniond::Identity());
+  m.orientation[0] = q.w();
+  m.orientation[1] = q.x();
+  m.orientation[2] = q.y();
+  m.orientation[3] = q.z();
+  m.has_magnetometer = imu.magnetic_field.has_value();
+  m.has_orientation = imu.orientation.has_value();
+  return m;
+}
+
+ImuSample fromMessage(const adit::imu_t& m) {
+  ImuSample imu;
+  imu.utime = m.header.utime;
+  imu.gyro = Eigen::Vector3d(m.angular_velocity[0], m.angular_velocity[1], m.angular_velocity[2]);
+  imu.accel = Eigen::Vector3d(m.linear_acceleration[0], m.linear_acceleration[1], m.linear_acceleration[2]);
+  if (m.has_magnetometer)
+    imu.magnetic_field = Eigen::Vector3d(m.magnetic_field[0], m.magnetic_field[1], m.magnetic_field[2]);
+  if (m.has_orientation)
+    imu.orientation = Eigen::Quaterniond(m.orientation[0], m.orientation[1], m.orientation[2], m.orientation[3]).normalized();
+  return imu;
+}
+
+adit::features_t toMessage(const FeatureSet& f) {
+  adit::features_t m;
+  m.header = makeHeader(f.utime, "lidar");
+  m.header.seq = f.cloud.seq;
+  m.cloud = toMessage(f.cloud);
+  m.corner_sharp = toMessage(f.corner_sharp, f.cloud);
+  m.corner_less_sharp = toMessage(f.corner_less_sharp, f.cloud);
+  m.surf_flat = toMessage(f.surf_flat, f.cloud);
+  m.surf_less_flat = toMessage(f.surf_less_flat, f.cloud);
+  const std::size_t n = std::min(f.keypoints.size(), f.descriptors.size());
+  m.num_keypoints = static_cast<std::int32_t>(n);
+  m.descriptor_size = static_cast<std::int16_t>(kLinK3dBins);
+  m.keypoints.assign(n, std::vector<float>(3));
+  m.descriptors.assign(n, std::vector<float>(kLinK3dBins));
+  for (std::size_t i = 0; i < n; ++i) {
+    for (int k = 0; k < 3; ++k) m.keypoints[i][k] = f.keypoints[i][k];
+    std::copy(f.descriptors[i].begin(), f.descriptors[i].end(), m.descriptors[i].begin());
+  }
+  m.flags = f.flags;
+  m.points_in = f.points_in;
+  m.removed_invalid = f.removed_invalid;
+  m.removed_range = f.removed_range;
+  m.removed_outlier = f.removed_outlier;
+  return m;
+}
+
+FeatureSet fromMessage(const adit::features_t& m) {
+  FeatureSet f;
+  f.utime = m.header.utime;
+  f.cloud = fromMessage(m.cloud);
+  f.corner_sharp = pointsFromMessage(m.corner_sharp);
+  f.corner_less_sharp = pointsFromMessage(m.corner_less_sharp);
+  f.surf_flat = pointsFromMessage(m.surf_flat);
+  f.surf_less_flat = pointsFromMessage(m.surf_less_flat);
+  // A descriptor of another size cannot be compared with ours: keep the keypoints only if sizes agree.
+  if (m.descriptor_size == kLinK3dBins) {
+    for (int i = 0; i < m.num_keypoints; ++i) {
+      f.keypoints.emplace_back(m.keypoints[i][0], m.keypoints[i][1], m.keypoints[i][2]);
+      LinK3dDescriptor d{};
+      std::copy(m.descriptors[i].begin(), m.descriptors[i].end(), d.begin());
+      f.descriptors.push_back(d);
+    }
+  }
+  f.flags = m.flags;
+  f.points_in = m.points_in;
+  f.removed_invalid = m.removed_invalid;
+  f.removed_range = m.removed_range;
+  f.removed_outlier = m.removed_outlier;
+  return f;
+}
+
+adit::odometry_t toMessage(const PoseEstimate& pose, const FeatureSet* features) {
+  adit::odometry_t m;
+  m.header = makeHeader(pose.utime, "world");
+  splitPose(pose.pose, m.position, m.orientation);
+  copyMatrix6(pose.covariance, m.covariance);
+  for (int i = 0; i < 3; ++i) {
+    m.translation_eigenvalues[i] = pose.translation_eigenvalues[i];
+    m.rotation_eigenvalues[i] = pose.rotation_eigenvalues[i];
+  }
+  m.flags = pose.flags;
+  m.iterations = pose.iterations;
+  m.final_cost = pose.final_cost;
+  m.features = features ? toMessage(*features) : toMessage(FeatureSet{});
+  return m;
+}
+
+PoseEstimate fromMessage(const adit::odometry_t& m) {
+  PoseEstimate p;
+  p.utime = m.header.utime;
+  p.pose = makePose(m.position, m.orientation);
+  p.covariance = readMatrix6(m.covariance);
+  for (int i = 0; i < 3; ++i) {
+    p.translation_eigenvalues[i] = m.translation_eigenvalues[i];
+    p.rotation_eigenvalues[i] = m.rotation_eigenvalues[i];
+  }
+  p.flags = m.flags;
+  p.iterations = m.iterations;
+  p.final_cost = m.final_cost;
+  return p;
+}
+
+adit::loop_closure_t toMessage(const LoopConstraint& loop, std::int64_t utime) {
+  adit::loop_closure_t m;
+  m.header = makeHeader(utime, "world");
+  m.query_index = loop.query_index;
+  m.match_index = loop.match_index;
+  m.query_utime = loop.query_utime;
+  m.match_utime = loop.match_utime;
+  splitPose(loop.T_match_query, m.relative_position, m.relative_orientation);
+  copyMatrix6(loop.information, m.information);
+  m.scan_context_distance = loop.scan_context_distance;
+  m.scan_context_yaw = loop.scan_context_yaw;
+  m.fitness = loop.fitness;
+  m.inlier_ratio = loop.inlier_ratio;
+  return m;
+}
+
+LoopConstraint fromMessage(const adit::loop_closure_t& m) {
+  LoopConstraint l;
+  l.query_index = m.query_index;
+  l.match_index = m.match_index;
+  l.query_utime = m.query_utime;
+  l.match_utime = m.match_utime;
+  l.T_match_query = makePose(m.relative_position, m.relative_orientation);
+  l.information = readMatrix6(m.information);
+  l.scan_context_distance = m.scan_context_distance;
+  l.scan_context_yaw = m.scan_context_yaw;
+  l.fitness = m.fitness;
+  l.inlier_ratio = m.inlier_ratio;
+  return l;
+}
+
+}  // namespace adit::msg

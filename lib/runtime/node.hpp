@@ -1,0 +1,130 @@
+// A node is one pipeline stage with LCM-typed inputs and outputs: it decodes what arrives on its input
+// channels, calls its (pure) stage, and publishes encoded results. The same node object runs live inside a
+// process (runtime/process.hpp) and in lockstep with other nodes in `adit replay` (runtime/lockstep.hpp),
+// so there is one code path from message to result.
+//
+// Inputs are checked before the stage sees them: undecodable bytes, wrong message type, and time going
+// backwards on a channel are counted and skipped (with one log line), never thrown.
+#pragma once
+
+#include "runtime/health.hpp"
+
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace adit::runtime {
+
+using Bytes = std::vector<std::uint8_t>;
+
+// Where a node's output goes (LCM in a process, the in-process bus in replay).
+class Sink {
+ public:
+  virtual ~Sink() = default;
+  virtual void publish(const std::string& channel, const Bytes& data, std::int64_t utime) = 0;
+};
+
+class Node {
+ public:
+  explicit Node(std::string name) : name_(std::move(name)) {}
+  virtual ~Node() = default;
+  Node(const Node&) = delete;
+  Node& operator=(const Node&) = delete;
+
+  const std::string& name() const { return name_; }
+
+  // Logical port -> channel name. Ports are declared by the subclass; remap before running.
+  void remap(const std::string& port, const std::string& channel);
+  const std::map<std::string, std::string>& channels() const { return channels_; }
+  std::vector<std::string> inputChannels() const;
+  bool isInput(const std::string& channel) const;
+
+  // Hand one encoded message that arrived on `channel` to the node; its outputs go to `sink`.
+  void deliver(const std::string& channel, const std::uint8_t* data, std::size_t size, Sink& sink);
+  // No more input will come (end of log, shutdown): publish what is pending.
+  void finish(Sink& sink);
+
+  const Health& health() const { return health_; }
+  const TimingWindow& timing() const { return timing_; }
+  // A short word for STATUS ("running", "behind", ...); subclasses may refine it.
+  virtual std::string state() const { return "running"; }
+
+  // Forward gaps in sensor time above this are counted as "time_jump" and reported to onTimeJump().
+  void setMaxTimeGap(double seconds) { max_time_gap_us_ = static_cast<std::int64_t>(seconds * 1e6); }
+
+ protected:
+  // Declare an input port. Handler is called with the decoded message, in arrival order.
+  template <class Msg>
+  void subscribe(const std::string& port, const std::string& default_channel, std::function<void(const Msg&)> handler);
+  // Declare an output port.
+  void advertise(const std::string& port, const std::string& default_channel);
+  // Encode and publish on a port; fills header.seq with the port's sequence number.
+  template <class Msg>
+  void publish(const std::string& port, Msg& msg);
+
+  void count(const std::string& counter, std::int64_t n = 1) { health_.counters[counter] += n; }
+  // Count an input that could not be used (errors) or was skipped (drops), with one log line.
+  void reportError(const std::string& counter, const std::string& message);
+  void reportDrop(const std::string& counter, const std::string& message);
+
+  // Called after a forward time gap on `port`, before the message is handled: reset temporal state.
+  virtual void onTimeJump(const std::string& /*port*/) {}
+  virtual void onFinish() {}
+
+ private:
+  struct Input {
+    std::string port;
+    std::function<void(const std::uint8_t*, std::size_t)> handle;
+    std::int64_t last_utime = -1;
+  };
+  // Returns false (and counts) if utime goes backwards or repeats on this input.
+  bool admit(Input& input, std::int64_t utime);
+  void emit(const std::string& port, Bytes bytes, std::int64_t utime);
+
+  std::string name_;
+  std::map<std::string, std::string> channels_;  // port -> channel
+  std::map<std::string, Input> inputs_;          // port -> input
+  std::map<std::string, std::int64_t> seq_;      // output port -> next sequence number
+  Health health_;
+  TimingWindow timing_;
+  Sink* sink_ = nullptr;  // valid during deliver()/finish()
+  std::int64_t max_time_gap_us_ = 1'000'000;
+};
+
+template <class Msg>
+void Node::subscribe(const std::string& port, const std::string& default_channel,
+                     std::function<void(const Msg&)> handler) {
+  channels_.emplace(port, default_channel);
+  Input input;
+  input.port = port;
+  input.handle = [this, port, handler = std::move(handler)](const std::uint8_t* data, std::size_t size) {
+    Msg msg;
+    int used = -1;
+    try {
+      used = msg.decode(data, 0, static_cast<int>(size));
+    } catch (const std::exception&) {
+      used = -1;  // absurd array sizes in a corrupt message can make decode allocate and throw
+    }
+    if (used < 0) {
+      reportError("decode_error", "undecodable message on " + channels_.at(port) + " (" + std::to_string(size) +
+                                      " bytes): skipped");
+      return;
+    }
+    if (!admit(inputs_.at(port), msg.header.utime)) return;
+    handler(msg);
+  };
+  inputs_[port] = std::move(input);
+}
+
+template <class Msg>
+void Node::publish(const std::string& port, Msg& msg) {
+  msg.header.seq = seq_[port]++;
+  Bytes bytes(static_cast<std::size_t>(msg.getEncodedSize()));
+  msg.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
+  emit(port, std::move(bytes), msg.header.utime);
+}
+
+}  // namespace adit::runtime

@@ -1,0 +1,153 @@
+#include "runtime/process.hpp"
+
+#include "runtime/status.hpp"
+
+#include <lcm/lcm-cpp.hpp>
+#include <fmt/ranges.h>
+#include <spdlog/spdlog.h>
+
+#include <chrono>
+#include <csignal>
+
+namespace adit::runtime {
+namespace {
+
+volatile std::sig_atomic_t g_stop = 0;  // the one process-wide flag a signal handler may set
+
+void onSignal(int) { g_stop = 1; }
+
+class LcmSink : public Sink {
+ public:
+  explicit LcmSink(lcm::LCM& lcm) : lcm_(lcm) {}
+  void publish(const std::string& channel, const Bytes& data, std::int64_t) override {
+    lcm_.publish(channel, data.data(), static_cast<unsigned int>(data.size()));
+  }
+
+ private:
+  lcm::LCM& lcm_;
+};
+
+// Receives raw LCM buffers and hands them to the node.
+class Receiver {
+ public:
+  Receiver(Node& node, Sink& sink) : node_(node), sink_(sink) {}
+  void onMessage(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
+    node_.deliver(channel, static_cast<const std::uint8_t*>(rbuf->data), rbuf->data_size, sink_);
+  }
+
+ private:
+  Node& node_;
+  Sink& sink_;
+};
+
+}  // namespace
+
+bool stopRequested() { return g_stop != 0; }
+
+void installStopHandlers() {
+  struct sigaction sa {};
+  sa.sa_handler = onSignal;
+  sigemptyset(&sa.sa_mask);
+  sigaction(SIGINT, &sa, nullptr);
+  sigaction(SIGTERM, &sa, nullptr);
+}
+
+std::int64_t wallUtime() {
+  return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch())
+      .count();
+}
+
+void addProcessOptions(CLI::App& app, ProcessOptions& o) {
+  app.add_option("--lcm-url", o.lcm_url, "LCM provider to subscribe to (default: $LCM_DEFAULT_URL or udpm)");
+  app.add_option("--out-url", o.out_url, "LCM provider to publish to (default: the --lcm-url one)");
+  app.add_option("--config", o.config_path, "YAML configuration (default: built-in defaults, see launch/config/)");
+  app.add_option("--channel", o.channel_remaps, "Rename a channel: PORT=CHANNEL (repeatable)");
+  app.add_option("--status-period", o.status_period_s, "Seconds between STATUS messages")->check(CLI::PositiveNumber);
+  app.add_option("--status-channel", o.status_channel, "STATUS channel (default STATUS_<process>)");
+}
+
+Config loadConfig(const std::string& path) { return path.empty() ? Config{} : Config::fromYamlFile(path); }
+
+void applyRemaps(Node& node, const std::vector<std::string>& remaps) {
+  for (const auto& r : remaps) {
+    const auto eq = r.find('=');
+    if (eq == std::string::npos || eq == 0 || eq + 1 == r.size())
+      throw std::runtime_error("--channel expects PORT=CHANNEL, got '" + r + "'");
+    node.remap(r.substr(0, eq), r.substr(eq + 1));
+  }
+}
+
+int runNodeProcess(int argc, char** argv, const std::string& name, const std::string& description,
+                   const NodeFactory& factory) {
+  CLI::App app{description, "adit-" + name};
+  ProcessOptions options;
+  addProcessOptions(app, options);
+  CLI11_PARSE(app, argc, argv);
+  spdlog::set_pattern("%H:%M:%S.%e %^%l%$ adit-" + name + ": %v");
+
+  std::unique_ptr<Node> node;
+  try {
+    node = factory(loadConfig(options.config_path));
+    applyRemaps(*node, options.channel_remaps);
+  } catch (const StageNotImplemented& e) {
+    spdlog::error("{}", e.what());
+    return 3;
+  } catch (const std::exception& e) {
+    spdlog::error("{}", e.what());
+    return 2;
+  }
+
+  lcm::LCM in(options.lcm_url);
+  if (!in.good()) {
+    spdlog::error("cannot open LCM '{}' (for udpm on one machine: ip route add 224.0.0.0/4 dev lo)", options.lcm_url);
+    return 1;
+  }
+  std::unique_ptr<lcm::LCM> separate_out;
+  if (!options.out_url.empty()) {
+    separate_out = std::make_unique<lcm::LCM>(options.out_url);
+    if (!separate_out->good()) {
+      spdlog::error("cannot open LCM '{}' for publishing", options.out_url);
+      return 1;
+    }
+  }
+  lcm::LCM& out = separate_out ? *separate_out : in;
+  LcmSink sink(out);
+  Receiver receiver(*node, sink);
+  for (const auto& channel : node->inputChannels()) in.subscribe(channel, &Receiver::onMessage, &receiver);
+
+  installStopHandlers();
+  const std::string status_channel = options.status_channel.empty() ? "STATUS_" + name : options.status_channel;
+  const auto start = std::chrono::steady_clock::now();
+  auto last_status = start;
+  std::int64_t status_seq = 0, inputs_at_last_status = 0;
+  const auto sendStatus = [&](const std::string& state) {
+    const auto now = std::chrono::steady_clock::now();
+    const double window = std::chrono::duration<double>(now - last_status).count();
+    const double rate = window > 0 ? static_cast<double>(node->health().inputs - inputs_at_last_status) / window : 0.0;
+    adit::status_t status = makeStatus(*node, wallUtime(), status_seq++,
+                                       std::chrono::duration<double>(now - start).count(), rate, state);
+    out.publish(status_channel, &status);
+    last_status = now;
+    inputs_at_last_status = node->health().inputs;
+  };
+
+  spdlog::info("listening on {} (status on {})", fmt::join(node->inputChannels(), ", "), status_channel);
+  sendStatus("starting");
+  bool end_of_input = false;
+  while (!stopRequested()) {
+    if (in.handleTimeout(100) < 0) {  // end of a file:// log, or a broken provider
+      end_of_input = true;
+      break;
+    }
+    if (std::chrono::steady_clock::now() - last_status >= std::chrono::duration<double>(options.status_period_s))
+      sendStatus(node->state());
+  }
+  node->finish(sink);
+  sendStatus("stopping");
+  const Health& h = node->health();
+  spdlog::info("{}: {} inputs, {} outputs, {} dropped, {} errors", end_of_input ? "end of input" : "stopped",
+               h.inputs, h.outputs, h.drops, h.errors);
+  return 0;
+}
+
+}  // namespace adit::runtime

@@ -1,0 +1,54 @@
+// Turns a Node into a process: flags, a live loop over LCM, STATUS at 1 Hz, clean shutdown on
+// SIGINT/SIGTERM. With `--lcm-url file:///in.lcmlog?speed=0 --out-url file:///out.lcmlog?mode=w` the same
+// process runs from a recording of its inputs to a log of its outputs.
+#pragma once
+
+#include "core/config.hpp"
+#include "runtime/node.hpp"
+
+#include <CLI/CLI.hpp>
+
+#include <functional>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace adit::runtime {
+
+// Thrown by a node factory whose stage is not written yet: the process says so and exits non-zero.
+struct StageNotImplemented : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+struct ProcessOptions {
+  std::string lcm_url;  // subscribe (and publish) here; "" = $LCM_DEFAULT_URL or LCM's default
+  std::string out_url;  // publish here instead, if set
+  std::string config_path;
+  std::vector<std::string> channel_remaps;  // PORT=CHANNEL
+  double status_period_s = 1.0;
+  std::string status_channel;  // "" = STATUS_<name>
+};
+
+void addProcessOptions(CLI::App& app, ProcessOptions& options);
+
+// Reads --config (empty path = built-in defaults). Throws std::runtime_error with a clear message.
+Config loadConfig(const std::string& path);
+
+// Applies PORT=CHANNEL remaps; throws std::runtime_error on a malformed one or an unknown port.
+void applyRemaps(Node& node, const std::vector<std::string>& remaps);
+
+using NodeFactory = std::function<std::unique_ptr<Node>(const Config&)>;
+
+// The whole main() of a stage process. Returns the exit code.
+int runNodeProcess(int argc, char** argv, const std::string& name, const std::string& description,
+                   const NodeFactory& factory);
+
+// Shared by every process: true once SIGINT or SIGTERM arrived (handlers installed on first call).
+bool stopRequested();
+void installStopHandlers();
+
+// Wall-clock microseconds, for STATUS stamps only.
+std::int64_t wallUtime();
+
+}  // namespace adit::runtime

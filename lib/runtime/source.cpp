@@ -1,0 +1,87 @@
+#include "runtime/source.hpp"
+
+#include "runtime/lcm_log.hpp"
+#include "runtime/process.hpp"
+#include "runtime/status.hpp"
+
+#include <lcm/lcm-cpp.hpp>
+#include <spdlog/spdlog.h>
+
+#include <chrono>
+#include <thread>
+
+namespace adit::runtime {
+namespace {
+
+int writeLog(MessageSource& source, const SourceRunOptions& options) {
+  LogWriter log(options.output_log);
+  OutgoingMessage m;
+  while (!stopRequested() && source.next(m)) log.write(m.channel, m.data, m.utime);
+  log.close();
+  const Health& h = source.health();
+  spdlog::info("wrote {} messages to {} ({} errors, {} skipped)", log.events(), options.output_log, h.errors, h.drops);
+  return 0;
+}
+
+int publishLive(MessageSource& source, const SourceRunOptions& options) {
+  lcm::LCM lcm(options.lcm_url);
+  if (!lcm.good()) {
+    spdlog::error("cannot open LCM '{}' (for udpm on one machine: ip route add 224.0.0.0/4 dev lo)", options.lcm_url);
+    return 1;
+  }
+  using Clock = std::chrono::steady_clock;
+  const std::string status_channel = "STATUS_" + options.process;
+  const auto start = Clock::now();
+  auto last_status = start;
+  std::int64_t status_seq = 0, published = 0, published_at_last_status = 0;
+  TimingWindow no_timing;
+  const auto sendStatus = [&](const std::string& state) {
+    const auto now = Clock::now();
+    const double window = std::chrono::duration<double>(now - last_status).count();
+    Health h = source.health();
+    h.outputs = published;
+    const double rate = window > 0 ? static_cast<double>(published - published_at_last_status) / window : 0.0;
+    adit::status_t s = makeStatus(options.process, h, no_timing, wallUtime(), status_seq++,
+                                  std::chrono::duration<double>(now - start).count(), rate, state);
+    lcm.publish(status_channel, &s);
+    last_status = now;
+    published_at_last_status = published;
+  };
+
+  // Sensor time t maps to wall time: start + (t - t0) / rate.
+  std::int64_t t0 = -1;
+  OutgoingMessage m;
+  sendStatus("starting");
+  while (!stopRequested() && source.next(m)) {
+    if (t0 < 0) t0 = m.utime;
+    if (options.rate > 0) {
+      const auto due = start + std::chrono::microseconds(static_cast<std::int64_t>(
+                                   static_cast<double>(m.utime - t0) / options.rate));
+      while (!stopRequested() && Clock::now() < due) {
+        std::this_thread::sleep_until(std::min(due, Clock::now() + std::chrono::milliseconds(50)));
+        if (Clock::now() - last_status >= std::chrono::duration<double>(options.status_period_s)) sendStatus("running");
+      }
+    }
+    lcm.publish(m.channel, m.data.data(), static_cast<unsigned int>(m.data.size()));
+    ++published;
+    if (Clock::now() - last_status >= std::chrono::duration<double>(options.status_period_s)) sendStatus("running");
+  }
+  sendStatus("stopping");
+  const Health& h = source.health();
+  spdlog::info("published {} messages ({} errors, {} skipped)", published, h.errors, h.drops);
+  return 0;
+}
+
+}  // namespace
+
+int runSource(MessageSource& source, const SourceRunOptions& options) {
+  installStopHandlers();
+  try {
+    return options.output_log.empty() ? publishLive(source, options) : writeLog(source, options);
+  } catch (const std::exception& e) {
+    spdlog::error("{}", e.what());
+    return 1;
+  }
+}
+
+}  // namespace adit::runtime

@@ -1,0 +1,39 @@
+// Runs a message source (a bridge reading files, the live simulator): either writes every message to an
+// LCM log as fast as it can, or publishes live over LCM paced by sensor time (times `rate`), with STATUS at
+// 1 Hz and a clean stop on SIGINT/SIGTERM. One implementation for every source process.
+#pragma once
+
+#include "runtime/health.hpp"
+#include "runtime/node.hpp"
+
+#include <string>
+
+namespace adit::runtime {
+
+struct OutgoingMessage {
+  std::string channel;
+  Bytes data;
+  std::int64_t utime = 0;  // sensor time: paces live publishing and stamps log events
+};
+
+class MessageSource {
+ public:
+  virtual ~MessageSource() = default;
+  // Next message in time order; false at the end. Recoverable problems are counted in health().
+  virtual bool next(OutgoingMessage& message) = 0;
+  virtual const Health& health() const = 0;
+};
+
+struct SourceRunOptions {
+  std::string process;         // for STATUS and log lines, e.g. "lidar-bridge"
+  std::string lcm_url;         // live publishing
+  std::string output_log;      // if set: write a log instead of publishing
+  double rate = 1.0;           // live: multiple of recorded speed (0 = as fast as possible)
+  double status_period_s = 1.0;
+  bool quiet = false;
+};
+
+// Returns the exit code (0 also when stopped by a signal).
+int runSource(MessageSource& source, const SourceRunOptions& options);
+
+}  // namespace adit::runtime
