@@ -1,0 +1,113 @@
+#include "features/link3d_match.hpp"
+
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+
+namespace adit {
+
+int linK3dScore(const LinK3dDescriptor& x, const LinK3dDescriptor& y, float tolerance) {
+  int score = 0;
+  for (int k = 0; k < kLinK3dBins; ++k)
+    score += (x[k] != 0.0f && y[k] != 0.0f && std::fabs(x[k] - y[k]) < tolerance) ? 1 : 0;
+  return score;
+}
+
+std::vector<LinK3dMatch> matchLinK3d(const std::vector<LinK3dDescriptor>& a, const std::vector<LinK3dDescriptor>& b,
+                                     const LinK3dConfig& cfg) {
+  std::vector<LinK3dMatch> best_for_b(b.size());
+  for (int i = 0; i < static_cast<int>(a.size()); ++i) {
+    LinK3dMatch best{i, -1, 0};
+    for (int j = 0; j < static_cast<int>(b.size()); ++j) {
+      const int s = linK3dScore(a[i], b[j], cfg.bin_tolerance);
+      if (s > best.score) best = {i, j, s};
+    }
+    if (best.b < 0 || best.score < cfg.min_score) continue;
+    if (best.score > best_for_b[best.b].score) best_for_b[best.b] = best;  // ties keep the lower a
+  }
+  std::vector<LinK3dMatch> out;
+  for (const LinK3dMatch& m : best_for_b)
+    if (m.b >= 0) out.push_back(m);
+  std::sort(out.begin(), out.end(), [](const LinK3dMatch& x, const LinK3dMatch& y) { return x.a < y.a; });
+  return out;
+}
+
+std::vector<LinK3dMatch> matchLinK3d(const FeatureSet& a, const FeatureSet& b, const LinK3dConfig& cfg) {
+  return matchLinK3d(a.descriptors, b.descriptors, cfg);
+}
+
+Eigen::Isometry3d features::fitRigid(const std::vector<Eigen::Vector3f>& ka, const std::vector<Eigen::Vector3f>& kb,
+                           const std::vector<LinK3dMatch>& pairs) {
+  Eigen::Matrix3Xd src(3, pairs.size()), dst(3, pairs.size());
+  for (std::size_t k = 0; k < pairs.size(); ++k) {
+    src.col(k) = kb[pairs[k].b].cast<double>();
+    dst.col(k) = ka[pairs[k].a].cast<double>();
+  }
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  if (pairs.size() >= 3) T.matrix() = Eigen::umeyama(src, dst, false);
+  return T;
+}
+
+namespace {
+
+std::vector<LinK3dMatch> inliersOf(const Eigen::Isometry3d& T, const std::vector<Eigen::Vector3f>& ka,
+                                   const std::vector<Eigen::Vector3f>& kb, const std::vector<LinK3dMatch>& m,
+                                   float threshold) {
+  std::vector<LinK3dMatch> in;
+  const double t2 = static_cast<double>(threshold) * threshold;
+  for (const LinK3dMatch& x : m)
+    if ((T * kb[x.b].cast<double>() - ka[x.a].cast<double>()).squaredNorm() < t2) in.push_back(x);
+  return in;
+}
+
+// Three pairs span a plane well enough to fix a rotation (triangle not degenerate in either cloud).
+bool wellShaped(const std::vector<Eigen::Vector3f>& k, int i, int j, int l) {
+  return (k[j] - k[i]).cross(k[l] - k[i]).norm() > 0.5f;  // twice the triangle area, m^2
+}
+
+}  // namespace
+
+RansacResult estimateTransformRansac(const std::vector<Eigen::Vector3f>& ka, const std::vector<Eigen::Vector3f>& kb,
+                                     const std::vector<LinK3dMatch>& matches, const RansacConfig& cfg) {
+  RansacResult best;
+  const int n = static_cast<int>(matches.size());
+  for (const LinK3dMatch& m : matches)
+    if (m.a < 0 || m.b < 0 || m.a >= static_cast<int>(ka.size()) || m.b >= static_cast<int>(kb.size())) return best;
+  if (n < 3) return best;
+  std::mt19937 rng(cfg.seed);
+  for (int it = 0; it < cfg.iterations; ++it) {
+    const int i = static_cast<int>(rng() % n), j = static_cast<int>(rng() % n), l = static_cast<int>(rng() % n);
+    if (i == j || j == l || i == l) continue;
+    const LinK3dMatch& mi = matches[i];
+    const LinK3dMatch& mj = matches[j];
+    const LinK3dMatch& ml = matches[l];
+    if (!wellShaped(ka, mi.a, mj.a, ml.a) || !wellShaped(kb, mi.b, mj.b, ml.b)) continue;
+    const Eigen::Isometry3d T = features::fitRigid(ka, kb, {mi, mj, ml});
+    std::vector<LinK3dMatch> in = inliersOf(T, ka, kb, matches, cfg.inlier_threshold);
+    if (in.size() > best.inliers.size()) {
+      best.T_a_b = T;
+      best.inliers = std::move(in);
+    }
+  }
+  if (best.inliers.size() < 3) return RansacResult{};
+  for (int refine = 0; refine < 10; ++refine) {  // least squares on the inliers until they stop changing
+    const Eigen::Isometry3d T = features::fitRigid(ka, kb, best.inliers);
+    std::vector<LinK3dMatch> in = inliersOf(T, ka, kb, matches, cfg.inlier_threshold);
+    if (in.size() < 3) break;
+    best.T_a_b = T;
+    const bool same = in.size() == best.inliers.size() &&
+                      std::equal(in.begin(), in.end(), best.inliers.begin(),
+                                 [](const LinK3dMatch& x, const LinK3dMatch& y) { return x.a == y.a && x.b == y.b; });
+    best.inliers = std::move(in);
+    if (same) break;
+  }
+  double sum2 = 0.0;
+  for (const LinK3dMatch& m : best.inliers) sum2 += (best.T_a_b * kb[m.b].cast<double>() - ka[m.a].cast<double>()).squaredNorm();
+  best.rms = best.inliers.empty() ? 0.0 : std::sqrt(sum2 / best.inliers.size());
+  best.ok = static_cast<int>(best.inliers.size()) >= std::max(3, cfg.min_inliers);
+  return best;
+}
+
+}  // namespace adit

@@ -1,0 +1,28 @@
+// Per-point smoothness along the scan line and the reliability masks shared by LOAM and LinK3D features.
+#pragma once
+
+#include "features/feature_config.hpp"
+#include "features/ring_cloud.hpp"
+
+#include <cstdint>
+#include <vector>
+
+namespace adit::features {
+
+struct PointScores {
+  std::vector<float> range;       // |p| (m)
+  std::vector<float> azimuth;     // atan2(y, x) (rad)
+  // Smoothness (LOAM paper eq. 1, normalised to be comparable across ranges and resolutions):
+  //   c_i = | sum_j (p_j - p_i) | / sum_j |p_j - p_i|   over the half_window neighbours on each side.
+  // LOAM divides the same sum by |S| |p_i|; dividing by the neighbours' spread instead removes both range
+  // (spread grows with range) and angular resolution (16 vs 64 beams), so one threshold fits every sensor.
+  // -1 where the window is incomplete (ring ends, gaps of missing returns).
+  std::vector<float> smoothness;
+  // 0 where the point must not become a feature: incomplete window, far side of a depth jump (occluded,
+  // it moves with the viewpoint), or a surface nearly parallel to the beam.
+  std::vector<std::uint8_t> usable;
+};
+
+PointScores scorePoints(const RingCloud& cloud, const LoamConfig& cfg);
+
+}  // namespace adit::features
