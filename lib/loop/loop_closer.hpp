@@ -1,0 +1,149 @@
+// The loop-closure stage: keyframes from the mapper's poses, Scan Context candidates, geometric verification,
+// consistency gates and a pose graph whose corrections go back to the mapper and into the final map.
+//
+// Per sweep: process(mapped pose, deskewed cloud). Every ~1 m / ~10 deg a keyframe is added with its
+// downsampled cloud and Scan Context; a candidate becomes a loop only if
+//   1. its Scan Context distance is below the threshold (database query excludes recent keyframes),
+//   2. ICP of the query keyframe against the candidate's submap fits tightly and constrains all 6 directions,
+//   3. the implied correction is plausible given the odometry uncertainty accumulated since the candidate
+//      (Mahalanobis gate), and
+//   4. it agrees with an accepted loop nearby, or with min_consistent_loops - 1 other pending loops.
+// Roadways are repetitive: a false loop is worse than a missed one, and the defaults lean that way.
+#pragma once
+
+#include "core/config.hpp"
+#include "core/types.hpp"
+#include "loop/loop_verifier.hpp"
+#include "loop/odometry_chain.hpp"
+#include "loop/pose_graph.hpp"
+#include "loop/scan_context_database.hpp"
+
+#include <optional>
+#include <vector>
+
+namespace adit {
+
+struct LoopCloserConfig {
+  // --- keyframes ---
+  double keyframe_distance = 1.0;   // m of mapped motion between keyframes (loop.keyframe_distance)
+  double keyframe_angle_deg = 10.0; // deg of mapped rotation between keyframes (loop.keyframe_angle_deg)
+  // Voxel (m) of the cloud kept per keyframe for verification and the corrected map: 0.2 m keeps rock-wall
+  // shape for point-to-plane normals at ~5-10k points per 16-beam keyframe.
+  double keyframe_voxel = 0.2;
+  // Build the Scan Context in a gravity-levelled frame (roll and pitch of the mapped pose removed), so that a
+  // sloping roadway or a tilted robot does not shift heights between visits.
+  bool level_scan_context = true;
+
+  // --- place recognition ---
+  ScanContextConfig scan_context;
+  int candidates = 10;                    // ring-key neighbours ranked per query
+  double max_scan_context_distance = 0.25;// accept candidates below this distance for verification
+  int max_verifications = 2;              // best candidates verified by ICP per keyframe
+  int exclude_recent_keyframes = 50;      // never match the newest N keyframes (~50 m of roadway)
+  double exclude_recent_seconds = 30.0;   // nor those from the last T seconds (a robot standing still)
+  int cooldown_keyframes = 3;             // after an accepted loop, skip detection for this many keyframes
+
+  // --- verification ---
+  LoopVerifierConfig verifier;
+
+  // --- consistency ---
+  // Odometry step noise added to each keyframe step (random-walk model, per sqrt of metres travelled) on top of
+  // the mapper's covariance: keeps the graph honest when the mapper is over-confident. 2 cm and 0.12 deg
+  // per sqrt(m) correspond to a LOAM-class drift of ~1 % over a few hundred metres.
+  double odometry_translation_sigma = 0.02;  // m / sqrt(m)
+  double odometry_rotation_sigma = 0.002;    // rad / sqrt(m)
+  double odometry_min_translation_sigma = 0.01; // m per step
+  double odometry_min_rotation_sigma = 0.001;   // rad per step
+  bool use_mapper_covariance = true;  // add the mapper's per-sweep covariances of the step (identity = unset)
+  // Loop measurement noise (ICP of a verified loop): a few cm and a fraction of a degree.
+  double loop_translation_sigma = 0.05;  // m
+  double loop_rotation_sigma = 0.01;     // rad
+  // Mahalanobis gate of the loop against the odometry (chi-square, 6 dof; 22.46 = 99.9 %).
+  double max_odometry_chi2 = 22.46;
+  // A loop is accepted when consistent (pairwise chi-square below max_pair_chi2) with an accepted loop whose
+  // query lies within consistency_window keyframes, or with min_consistent_loops - 1 pending verified loops
+  // there. 2 = never trust a single match in a repetitive roadway.
+  int min_consistent_loops = 2;
+  int consistency_window = 20;
+  double max_pair_chi2 = 22.46;
+
+  // --- pose graph ---
+  PoseGraphConfig graph;
+};
+
+LoopCloserConfig loopCloserConfigFrom(const Config& config);  // keys "loop.<field>", see README
+
+struct LoopCloserStats {
+  int sweeps = 0;
+  int invalid_sweeps = 0;      // non-finite pose: skipped
+  int keyframes = 0;
+  int queries = 0;             // keyframes searched for a place match
+  int candidates = 0;          // candidates under the Scan Context threshold
+  int rejected_fitness = 0;    // ICP did not fit (or too few points)
+  int rejected_degenerate = 0; // ICP fit but left a direction unconstrained
+  int rejected_odometry = 0;   // Mahalanobis gate against the odometry uncertainty
+  int rejected_pairwise = 0;   // inconsistent with an accepted loop nearby
+  int pending = 0;             // verified loops waiting for a consistent partner
+  int accepted = 0;
+  int optimizations = 0;
+};
+
+class LoopCloser {
+ public:
+  struct Result {
+    bool keyframe_added = false;
+    std::optional<LoopConstraint> loop;  // the last loop accepted by this call
+    std::vector<LoopConstraint> loops;   // every loop accepted by this call (a pending one may join)
+    bool graph_updated = false;
+    std::vector<StampedPose> corrected_keyframes;  // all keyframes, filled only when graph_updated
+    // Correction of the newest keyframe: corrected pose = T_corrected_uncorrected * mapped pose.
+    Eigen::Isometry3d T_corrected_uncorrected = Eigen::Isometry3d::Identity();
+  };
+
+  explicit LoopCloser(const LoopCloserConfig& config = {});
+
+  // cloud: deskewed sweep in the lidar frame at mapped.utime. keypoints are accepted for API compatibility with
+  // LinK3D seeding but not used yet.
+  Result process(const PoseEstimate& mapped, const LidarScan& cloud,
+                 const std::vector<Eigen::Vector3f>* keypoints = nullptr);
+
+  // Per-sweep poses corrected by interpolating (in time) the corrections of the surrounding keyframes.
+  Trajectory correctedTrajectory(const Trajectory& uncorrected) const;
+  // Keyframe clouds at their corrected poses, voxel-downsampled (voxel <= 0: no downsampling).
+  std::vector<Eigen::Vector3f> correctedMap(double voxel) const;
+
+  struct Keyframe {
+    std::int64_t utime = 0;
+    Eigen::Isometry3d uncorrected = Eigen::Isometry3d::Identity();  // mapped T_world_lidar
+    std::vector<Eigen::Vector3f> cloud;  // downsampled, lidar frame
+  };
+  const std::vector<Keyframe>& keyframes() const { return keyframes_; }
+  const PoseGraph& graph() const { return graph_; }
+  const std::vector<LoopConstraint>& acceptedLoops() const { return accepted_; }
+  const LoopCloserStats& stats() const { return stats_; }
+  const LoopCloserConfig& config() const { return config_; }
+  Eigen::Isometry3d correction(int keyframe) const;  // X_k * U_k^-1
+
+ private:
+  bool isKeyframe(const Eigen::Isometry3d& pose) const;
+  void addKeyframe(const PoseEstimate& mapped, const LidarScan& cloud);
+  Matrix6d stepCovariance(const Eigen::Isometry3d& new_pose) const;
+  std::vector<LoopConstraint> detectLoops(int query);
+  std::optional<LoopConstraint> verifyCandidate(int query, const ScanContextCandidate& candidate);
+  std::vector<LoopConstraint> admit(const LoopConstraint& loop);
+  bool pairConsistent(const LoopConstraint& a, const LoopConstraint& b) const;
+  Matrix6d loopCovariance() const;
+
+  LoopCloserConfig config_;
+  std::vector<Keyframe> keyframes_;
+  OdometryChain chain_;
+  PoseGraph graph_;
+  ScanContextDatabase database_;
+  std::vector<LoopConstraint> accepted_;
+  std::vector<LoopConstraint> pending_;
+  std::vector<std::pair<Eigen::Isometry3d, Matrix6d>> sweeps_since_keyframe_;  // pose, covariance
+  int last_loop_query_ = -1000000;
+  LoopCloserStats stats_;
+};
+
+}  // namespace adit

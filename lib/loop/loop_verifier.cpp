@@ -1,0 +1,60 @@
+#include "loop/loop_verifier.hpp"
+
+#include "loop/voxel_filter.hpp"
+
+namespace adit {
+
+std::vector<Eigen::Vector3f> buildSubmap(const std::vector<SubmapPiece>& pieces, double voxel) {
+  std::vector<Eigen::Vector3f> merged;
+  for (const SubmapPiece& piece : pieces) {
+    if (!piece.cloud) continue;
+    const Eigen::Isometry3f T = piece.T_match_keyframe.cast<float>();
+    for (const Eigen::Vector3f& p : *piece.cloud) merged.push_back(T * p);
+  }
+  return voxelDownsample(merged, voxel);
+}
+
+namespace {
+
+bool fits(const IcpResult& r, const LoopVerifierConfig& config) {
+  return r.converged && r.rms <= config.max_rms && r.inlier_ratio >= config.min_inlier_ratio;
+}
+
+}  // namespace
+
+LoopVerification verifyLoop(const std::vector<Eigen::Vector3f>& query_cloud,
+                            const std::vector<Eigen::Vector3f>& submap,
+                            const std::vector<Eigen::Isometry3d>& seeds, const LoopVerifierConfig& config) {
+  LoopVerification out;
+  const std::vector<Eigen::Vector3f> source = voxelDownsample(query_cloud, config.query_voxel);
+  const PlaneTarget target(submap, config.icp);
+  if (source.size() < 30 || target.planarPoints() < 30 || seeds.empty()) return out;
+
+  out.verdict = LoopVerdict::kPoorFitness;
+  for (std::size_t i = 0; i < seeds.size(); ++i) {
+    const IcpResult r = alignPointToPlane(target, source, seeds[i], config.icp);
+    const bool better = out.seed < 0 || r.inlier_ratio > out.icp.inlier_ratio;
+    if (fits(r, config) || better) {
+      out.icp = r;
+      out.seed = static_cast<int>(i);
+      out.T_match_query = r.T_target_source;
+    }
+    if (fits(r, config)) break;
+  }
+  if (!fits(out.icp, config)) return out;
+  out.verdict = out.icp.eigenvalue_ratio >= config.min_eigenvalue_ratio ? LoopVerdict::kAccepted
+                                                                         : LoopVerdict::kDegenerate;
+  return out;
+}
+
+const char* toString(LoopVerdict verdict) {
+  switch (verdict) {
+    case LoopVerdict::kAccepted: return "accepted";
+    case LoopVerdict::kTooFewPoints: return "too few points";
+    case LoopVerdict::kPoorFitness: return "poor fitness";
+    case LoopVerdict::kDegenerate: return "degenerate";
+  }
+  return "unknown";
+}
+
+}  // namespace adit

@@ -1,0 +1,38 @@
+// The uncorrected keyframe poses from the mapper and the covariance of each odometry step between them:
+// what the graph's uncertainty between two keyframes is before any loop, used to gate loop candidates.
+#pragma once
+
+#include "loop/se3.hpp"
+
+#include <vector>
+
+namespace adit {
+
+class OdometryChain {
+ public:
+  // First call: the first keyframe (its covariance is ignored). Later calls: the step from the previous
+  // keyframe, covariance in the new keyframe's frame (right perturbation of T_previous_new).
+  void add(const Eigen::Isometry3d& T_world_keyframe, const Matrix6d& step_covariance);
+  int size() const { return static_cast<int>(poses_.size()); }
+  const Eigen::Isometry3d& pose(int k) const { return poses_[static_cast<std::size_t>(k)]; }
+
+  // Covariance of T_a_b accumulated along the chain a..b (a < b), expressed in b's frame:
+  // sum over steps k in (a, b] of Ad(T_b_k) Sigma_k Ad(T_b_k)^T. Zero when a >= b.
+  Matrix6d covarianceBetween(int a, int b) const;
+
+ private:
+  std::vector<Eigen::Isometry3d> poses_;
+  std::vector<Matrix6d> step_covariances_;  // [k]: step k-1 -> k ([0] unused)
+};
+
+// Chi-square of a loop measurement Z = T_match_query against the graph's current estimate T_match_query_graph,
+// given the chain covariance between the two keyframes and the loop's own covariance.
+double loopChi2(const Eigen::Isometry3d& Z, const Eigen::Isometry3d& T_match_query_graph,
+                const Matrix6d& chain_covariance, const Matrix6d& loop_covariance);
+
+// Chi-square of the cycle closed by two loops (m_a -> q_a and m_b -> q_b): the query-side relative pose must
+// equal Z_a^-1 * T_ma_mb * Z_b.
+double pairChi2(const Eigen::Isometry3d& Z_a, const Eigen::Isometry3d& Z_b, const Eigen::Isometry3d& T_ma_mb,
+                const Eigen::Isometry3d& T_qa_qb, const Matrix6d& cycle_covariance);
+
+}  // namespace adit

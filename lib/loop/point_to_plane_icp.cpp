@@ -1,0 +1,154 @@
+#include "loop/point_to_plane_icp.hpp"
+
+#include "core/geometry.hpp"
+
+#include <pcl/kdtree/kdtree_flann.h>
+#include <pcl/point_cloud.h>
+#include <pcl/point_types.h>
+
+#include <Eigen/Eigenvalues>
+
+#include <cmath>
+
+namespace adit {
+
+struct PlaneTarget::Impl {
+  pcl::PointCloud<pcl::PointXYZ>::Ptr planar{new pcl::PointCloud<pcl::PointXYZ>};
+  std::vector<Eigen::Vector3d> normals;
+  pcl::KdTreeFLANN<pcl::PointXYZ> tree{false};  // unsorted results are fine for k = 1
+};
+
+PlaneTarget::PlaneTarget(const std::vector<Eigen::Vector3f>& points, const IcpConfig& config)
+    : impl_(std::make_unique<Impl>()) {
+  pcl::PointCloud<pcl::PointXYZ>::Ptr all(new pcl::PointCloud<pcl::PointXYZ>);
+  for (const auto& p : points)
+    if (p.allFinite()) all->push_back(pcl::PointXYZ(p.x(), p.y(), p.z()));
+  const int k = std::max(3, config.normal_neighbors);
+  if (static_cast<int>(all->size()) < k) return;
+  pcl::KdTreeFLANN<pcl::PointXYZ> all_tree;
+  all_tree.setInputCloud(all);
+  std::vector<int> idx;
+  std::vector<float> sq;
+  for (const pcl::PointXYZ& p : all->points) {
+    if (all_tree.nearestKSearch(p, k, idx, sq) < k) continue;
+    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+    for (int i : idx) mean += all->points[static_cast<std::size_t>(i)].getVector3fMap().cast<double>();
+    mean /= k;
+    Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+    for (int i : idx) {
+      const Eigen::Vector3d d = all->points[static_cast<std::size_t>(i)].getVector3fMap().cast<double>() - mean;
+      cov += d * d.transpose();
+    }
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);
+    const double total = eig.eigenvalues().sum();
+    if (total <= 0.0 || eig.eigenvalues()[0] / total > config.max_surface_variation) continue;
+    impl_->planar->push_back(p);
+    impl_->normals.push_back(eig.eigenvectors().col(0));
+  }
+  if (!impl_->planar->empty()) impl_->tree.setInputCloud(impl_->planar);
+}
+
+PlaneTarget::~PlaneTarget() = default;
+
+int PlaneTarget::planarPoints() const { return static_cast<int>(impl_->planar->size()); }
+
+bool PlaneTarget::nearest(const Eigen::Vector3d& query, double max_distance, Eigen::Vector3d& point,
+                          Eigen::Vector3d& normal) const {
+  if (impl_->planar->empty()) return false;
+  std::vector<int> idx(1);
+  std::vector<float> sq(1);
+  const pcl::PointXYZ q(static_cast<float>(query.x()), static_cast<float>(query.y()), static_cast<float>(query.z()));
+  if (impl_->tree.nearestKSearch(q, 1, idx, sq) < 1 || sq[0] > max_distance * max_distance) return false;
+  point = impl_->planar->points[static_cast<std::size_t>(idx[0])].getVector3fMap().cast<double>();
+  normal = impl_->normals[static_cast<std::size_t>(idx[0])];
+  return true;
+}
+
+namespace {
+
+struct Linearisation {
+  Matrix6d H = Matrix6d::Zero();
+  Eigen::Matrix<double, 6, 1> g = Eigen::Matrix<double, 6, 1>::Zero();
+  Matrix6d H_inliers = Matrix6d::Zero();
+  int correspondences = 0;
+  int inliers = 0;
+  double inlier_sq_sum = 0.0;
+};
+
+// Residual r = n . (T s - q); left perturbation T <- Exp(d) T gives dr/d(t, w) = [n, (T s) x n].
+Linearisation linearise(const PlaneTarget& target, const std::vector<Eigen::Vector3d>& source,
+                        const Eigen::Isometry3d& T, double max_distance, double inlier_residual) {
+  Linearisation lin;
+  Eigen::Vector3d q, n;
+  for (const Eigen::Vector3d& s : source) {
+    const Eigen::Vector3d p = T * s;
+    if (!target.nearest(p, max_distance, q, n)) continue;
+    const double r = n.dot(p - q);
+    Eigen::Matrix<double, 6, 1> J;
+    J.head<3>() = n;
+    J.tail<3>() = p.cross(n);
+    // Huber-like weight at the inlier scale: far matches pull, but not quadratically.
+    const double w = std::abs(r) <= inlier_residual ? 1.0 : inlier_residual / std::abs(r);
+    lin.H += w * J * J.transpose();
+    lin.g += w * J * r;
+    ++lin.correspondences;
+    if (std::abs(r) <= inlier_residual) {
+      lin.H_inliers += J * J.transpose();
+      lin.inlier_sq_sum += r * r;
+      ++lin.inliers;
+    }
+  }
+  return lin;
+}
+
+// Gauss-Newton at one correspondence gate; returns true when the update became small.
+bool runPhase(const PlaneTarget& target, const std::vector<Eigen::Vector3d>& source, double gate,
+              const IcpConfig& config, Eigen::Isometry3d& T, int& iterations) {
+  for (int it = 0; it < config.max_iterations; ++it) {
+    const Linearisation lin = linearise(target, source, T, gate, config.inlier_residual);
+    ++iterations;
+    if (lin.correspondences < 6) return false;
+    const Eigen::Matrix<double, 6, 1> delta = -(lin.H + 1e-9 * Matrix6d::Identity()).ldlt().solve(lin.g);
+    if (!delta.allFinite()) return false;
+    Eigen::Isometry3d step = Eigen::Isometry3d::Identity();
+    step.linear() = expRotation(delta.tail<3>());
+    step.translation() = delta.head<3>();
+    T = step * T;
+    if (delta.head<3>().norm() < config.converged_translation && delta.tail<3>().norm() < config.converged_rotation)
+      return true;
+  }
+  return false;
+}
+
+}  // namespace
+
+IcpResult alignPointToPlane(const PlaneTarget& target, const std::vector<Eigen::Vector3f>& source,
+                            const Eigen::Isometry3d& initial_T_target_source, const IcpConfig& config) {
+  IcpResult result;
+  result.T_target_source = initial_T_target_source;
+  std::vector<Eigen::Vector3d> src;
+  src.reserve(source.size());
+  for (const auto& p : source)
+    if (p.allFinite()) src.push_back(p.cast<double>());
+  if (src.size() < 6 || target.planarPoints() < 6 || !initial_T_target_source.matrix().allFinite()) return result;
+
+  Eigen::Isometry3d T = initial_T_target_source;
+  runPhase(target, src, config.coarse_correspondence_distance, config, T, result.iterations);
+  result.converged = runPhase(target, src, config.fine_correspondence_distance, config, T, result.iterations);
+  result.T_target_source = T;
+
+  const Linearisation lin = linearise(target, src, T, config.fine_correspondence_distance, config.inlier_residual);
+  result.correspondences = lin.correspondences;
+  result.inlier_ratio = static_cast<double>(lin.inliers) / static_cast<double>(src.size());
+  result.rms = lin.inliers > 0 ? std::sqrt(lin.inlier_sq_sum / lin.inliers) : 0.0;
+  result.hessian = lin.H_inliers;
+  Matrix6d S = Matrix6d::Identity();
+  S.bottomRightCorner<3, 3>() /= std::max(1e-3, config.characteristic_length);
+  const Eigen::SelfAdjointEigenSolver<Matrix6d> eig(S * lin.H_inliers * S);
+  result.eigenvalues = eig.eigenvalues();
+  const double largest = result.eigenvalues[5];
+  result.eigenvalue_ratio = largest > 0.0 ? std::max(0.0, result.eigenvalues[0]) / largest : 0.0;
+  return result;
+}
+
+}  // namespace adit
