@@ -1,0 +1,58 @@
+// Robot motion: drives the world's route like a crawler/wheeled mine robot and returns the lidar's ground-truth
+// trajectory as a smooth B-spline.
+//
+// Model (all from the seed):
+//  - speed profile along the route: cruise speed with slow +-variation, slowed to the lateral-acceleration limit
+//    in corners (turns at junctions), accelerations limited to max_accel / max_decel, starting from rest after
+//    a still period (lets IMU-based pipelines initialise gravity and biases) and stopping at the route's end;
+//  - a slow lateral wander around the centre line (nobody drives a perfect line);
+//  - height, pitch and roll from the floor relief under the four track corners (so pitch/roll really come from
+//    the rugged floor), plus crawler vibration (AR(1) noise in pitch, roll, yaw and height, scaled by speed);
+//  - the lidar sits mount_height above the ground on the body z axis; the IMU is at the lidar (identity extrinsic).
+// The resulting poses are sampled every knot_spacing seconds and become the control points of the spline; the
+// spline IS the ground truth (its derivatives feed the IMU).
+#pragma once
+
+#include "core/config.hpp"
+#include "sim/bspline_trajectory.hpp"
+#include "sim/world.hpp"
+
+#include <cstdint>
+#include <vector>
+
+namespace adit::sim {
+
+struct MotionConfig {
+  double cruise_speed = 1.3;     // m/s; mine robots drive 0.5-1.5 m/s
+  double speed_variation = 0.1;  // relative slow variation of the cruise speed (+-)
+  double max_speed = 1.5;        // m/s hard cap
+  double max_accel = 0.3;        // m/s^2 (a crawler on a rough floor)
+  double max_decel = 0.5;        // m/s^2
+  double lateral_accel = 0.3;    // m/s^2 in corners -> ~0.77 m/s through a 2 m radius turn
+  double corner_radius = 2.0;    // m, fits a 4.5 m wide junction
+  double wander = 0.15;          // m, amplitude of the lateral wander around the centre line
+  double start_still = 2.0;      // s standing still at the start
+  double mount_height = 1.0;     // m, lidar above the ground contact
+  double track_length = 1.2;     // m, contact patch distance front-rear (pitch from the floor)
+  double track_width = 0.8;      // m, left-right (roll from the floor)
+  double vibration_deg = 0.3;    // deg RMS pitch/roll vibration at 1 m/s (yaw gets a third of it)
+  double bounce = 0.004;         // m RMS vertical vibration at 1 m/s
+  double vibration_time = 0.08;  // s, correlation time of the vibration
+  double knot_spacing = 0.02;    // s between spline control points (vibration content up to ~10 Hz)
+};
+
+// Keys "sim.motion.<field>" with the defaults above.
+MotionConfig motionConfigFrom(const adit::Config& c);
+
+struct PlannedMotion {
+  BSplineTrajectory trajectory;  // T_world_lidar, valid on [0, duration + 1 s]
+  // Distance along the route driven by time knot_times[k] (monotonic): for "how long to drive X metres".
+  std::vector<double> knot_times, knot_distance;
+  double route_length = 0.0;  // total length of the (possibly repeated) route that was planned (m)
+  double timeAtDistance(double metres) const;  // first time the robot has driven `metres`; +inf if never
+};
+
+// Plans `duration` seconds (+1 s margin) of motion along world.route. Closed routes are repeated lap after lap.
+PlannedMotion planMotion(const World& world, const MotionConfig& config, double duration, std::uint64_t seed);
+
+}  // namespace adit::sim
