@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <limits>
 #include <sstream>
 
@@ -66,13 +67,69 @@ FieldReader findField(const pcl::PCLPointCloud2& cloud, const std::string& name)
   return f;
 }
 
+std::uint32_t bytesOf(std::uint8_t datatype) {
+  switch (datatype) {
+    case pcl::PCLPointField::INT8:
+    case pcl::PCLPointField::UINT8: return 1;
+    case pcl::PCLPointField::INT16:
+    case pcl::PCLPointField::UINT16: return 2;
+    case pcl::PCLPointField::INT32:
+    case pcl::PCLPointField::UINT32:
+    case pcl::PCLPointField::FLOAT32: return 4;
+    case pcl::PCLPointField::INT64:
+    case pcl::PCLPointField::UINT64:
+    case pcl::PCLPointField::FLOAT64: return 8;
+    default: return 0;
+  }
+}
+
+// PCL's reader trusts the header (a garbage file can crash it), so the header and the body size are
+// checked here first. Returns an empty string if the file is safe to hand to PCL, else the problem.
+std::string checkPcdFile(const std::string& path) {
+  pcl::PCLPointCloud2 header;
+  Eigen::Vector4f origin;
+  Eigen::Quaternionf orientation;
+  int version = 0, data_type = 0;
+  unsigned int data_idx = 0;
+  pcl::PCDReader reader;
+  if (reader.readHeader(path, header, origin, orientation, version, data_type, data_idx) < 0) return "no valid PCD header";
+  if (header.fields.empty()) return "header lists no fields";
+  std::uint64_t point_bytes = 0;
+  for (const auto& f : header.fields) {
+    if (bytesOf(f.datatype) == 0 || f.count < 1) return "field '" + f.name + "' has an unknown type or count";
+    point_bytes += static_cast<std::uint64_t>(bytesOf(f.datatype)) * f.count;
+  }
+  const std::uint64_t body = point_bytes * header.width * header.height;
+  const std::uint64_t file_bytes = fs::file_size(path);
+  std::uint64_t values_per_point = 0;
+  for (const auto& f : header.fields) values_per_point += f.count;
+  // ascii: every value takes at least a digit and a separator; catches a huge WIDTH before PCL allocates.
+  if (data_type == 0 && file_bytes < data_idx + 2 * values_per_point * header.width * header.height)
+    return "truncated: too few bytes for the announced " + std::to_string(header.width * header.height) + " points";
+  if (data_type == 1 && file_bytes < data_idx + body)  // binary: raw body follows the header
+    return "truncated: " + std::to_string(file_bytes) + " bytes, header announces " + std::to_string(data_idx + body);
+  if (data_type == 2 && body > 0) {  // binary_compressed: uint32 compressed size, uint32 raw size, LZF data
+    std::ifstream in(path, std::ios::binary);
+    std::uint32_t sizes[2] = {0, 0};
+    in.seekg(data_idx);
+    if (!in.read(reinterpret_cast<char*>(sizes), sizeof(sizes))) return "truncated before the compressed body";
+    if (sizes[1] != body) return "compressed body size does not match the header";
+    if (file_bytes < data_idx + 8ull + sizes[0]) return "truncated compressed body";
+  }
+  return "";
+}
+
 pcl::PCLPointCloud2 loadCloud(const std::string& path) {
   if (!fs::is_regular_file(path)) throw ReadError("PCD: file '" + path + "' does not exist");
   pcl::PCLPointCloud2 cloud;
   int status = -1;
   try {
+    const std::string problem = checkPcdFile(path);
+    if (!problem.empty()) throw ReadError("PCD: '" + path + "' is corrupt: " + problem);
     pcl::PCDReader reader;
     status = reader.read(path, cloud);
+  } catch (const ReadError&) {
+    throw;
   } catch (const std::exception& e) {
     throw ReadError("PCD: cannot parse '" + path + "': " + e.what());
   }
@@ -297,7 +354,7 @@ void writePcd(const std::string& path, const std::vector<LidarPoint>& points, co
   const std::string header =
       writer.generateHeaderBinary(cloud, Eigen::Vector4f::Zero(), Eigen::Quaternionf::Identity());
   writeFileAtomically(path, [&](std::ostream& out) {
-    out << header;
+    out << header << "DATA binary\n";
     out.write(reinterpret_cast<const char*>(cloud.data.data()), static_cast<std::streamsize>(cloud.data.size()));
   });
 }
