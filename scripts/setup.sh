@@ -36,5 +36,5 @@ fi
 
 [ "${1:-}" = "--no-build" ] && exit 0
 
-cmake -S . -B build -DCMAKE_BUILD_TYPE="${ADIT_BUILD_TYPE:-Release}" >/dev/null
+cmake -S . -B build -DCMAKE_BUILD_TYPE="${ADIT_BUILD_TYPE:-Release}" -DADIT_STRICT=ON >/dev/null
 cmake --build build -j"${ADIT_JOBS:-2}"

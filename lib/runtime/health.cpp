@@ -8,7 +8,7 @@ namespace adit::runtime {
 
 void TimingWindow::add(double ms) {
   samples_.push_back(ms);
-  while (samples_.size() > capacity_) samples_.pop_front();
+  while (capacity_ > 0 && samples_.size() > capacity_) samples_.pop_front();
 }
 
 double TimingWindow::quantile(double q) const {

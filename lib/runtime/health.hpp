@@ -22,6 +22,8 @@ struct Health {
 class TimingWindow {
  public:
   explicit TimingWindow(std::size_t capacity = 200) : capacity_(capacity) {}
+  // Replay keeps every sample (capacity 0 = unbounded) for its timing report.
+  void setCapacity(std::size_t capacity) { capacity_ = capacity; }
   void add(double ms);
   // q in [0, 1]; 0 if empty.
   double quantile(double q) const;

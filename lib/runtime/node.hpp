@@ -49,6 +49,7 @@ class Node {
 
   const Health& health() const { return health_; }
   const TimingWindow& timing() const { return timing_; }
+  TimingWindow& timing() { return timing_; }
   // A short word for STATUS ("running", "behind", ...); subclasses may refine it.
   virtual std::string state() const { return "running"; }
 

@@ -116,7 +116,7 @@ int runNodeProcess(int argc, char** argv, const std::string& name, const std::st
   for (const auto& channel : node->inputChannels()) in.subscribe(channel, &Receiver::onMessage, &receiver);
 
   installStopHandlers();
-  const std::string status_channel = options.status_channel.empty() ? "STATUS_" + name : options.status_channel;
+  const std::string status_channel = options.status_channel.empty() ? statusChannel(name) : options.status_channel;
   const auto start = std::chrono::steady_clock::now();
   auto last_status = start;
   std::int64_t status_seq = 0, inputs_at_last_status = 0;

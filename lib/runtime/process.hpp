@@ -27,7 +27,7 @@ struct ProcessOptions {
   std::string config_path;
   std::vector<std::string> channel_remaps;  // PORT=CHANNEL
   double status_period_s = 1.0;
-  std::string status_channel;  // "" = STATUS_<name>
+  std::string status_channel;  // "" = STATUS_<NAME>
 };
 
 void addProcessOptions(CLI::App& app, ProcessOptions& options);

@@ -30,7 +30,7 @@ int publishLive(MessageSource& source, const SourceRunOptions& options) {
     return 1;
   }
   using Clock = std::chrono::steady_clock;
-  const std::string status_channel = "STATUS_" + options.process;
+  const std::string status_channel = statusChannel(options.process);
   const auto start = Clock::now();
   auto last_status = start;
   std::int64_t status_seq = 0, published = 0, published_at_last_status = 0;

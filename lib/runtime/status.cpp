@@ -1,6 +1,14 @@
 #include "runtime/status.hpp"
 
+#include <cctype>
+
 namespace adit::runtime {
+
+std::string statusChannel(const std::string& process) {
+  std::string out = "STATUS_";
+  for (char c : process) out += c == '-' ? '_' : static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+  return out;
+}
 
 adit::status_t makeStatus(const std::string& process, const Health& health, const TimingWindow& timing,
                           std::int64_t wall_utime, std::int64_t seq, double uptime_s, double rate_hz,

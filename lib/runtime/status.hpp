@@ -7,6 +7,9 @@
 
 namespace adit::runtime {
 
+// STATUS_<PROCESS> in capitals, '-' as '_': "loop-closer" -> "STATUS_LOOP_CLOSER".
+std::string statusChannel(const std::string& process);
+
 // wall_utime: the report time (monitoring only); rate_hz: inputs per second over the last window.
 adit::status_t makeStatus(const Node& node, std::int64_t wall_utime, std::int64_t seq, double uptime_s,
                           double rate_hz, const std::string& state);

@@ -1,0 +1,80 @@
+#include "launch/launch_file.hpp"
+
+#include <yaml-cpp/yaml.h>
+
+#include <cstdlib>
+#include <stdexcept>
+
+namespace adit::launch {
+namespace {
+
+std::string substitute(const std::string& text, const std::map<std::string, std::string>& vars,
+                       const std::string& where) {
+  std::string out;
+  std::size_t i = 0;
+  while (i < text.size()) {
+    const std::size_t start = text.find("${", i);
+    if (start == std::string::npos) {
+      out += text.substr(i);
+      break;
+    }
+    const std::size_t end = text.find('}', start);
+    if (end == std::string::npos) throw std::runtime_error(where + ": unclosed ${ in '" + text + "'");
+    out += text.substr(i, start - i);
+    const std::string name = text.substr(start + 2, end - start - 2);
+    if (auto it = vars.find(name); it != vars.end()) {
+      out += it->second;
+    } else if (const char* env = std::getenv(name.c_str())) {
+      out += env;
+    } else {
+      throw std::runtime_error(where + ": variable ${" + name + "} is not set (pass --set " + name + "=...)");
+    }
+    i = end + 1;
+  }
+  return out;
+}
+
+Restart parseRestart(const std::string& s, const std::string& where) {
+  if (s == "never") return Restart::Never;
+  if (s == "on-failure") return Restart::OnFailure;
+  if (s == "always") return Restart::Always;
+  throw std::runtime_error(where + ": restart must be never, on-failure or always, not '" + s + "'");
+}
+
+}  // namespace
+
+LaunchSpec loadLaunchFile(const std::string& path, const std::map<std::string, std::string>& vars) {
+  YAML::Node root;
+  try {
+    root = YAML::LoadFile(path);
+  } catch (const YAML::Exception& e) {
+    throw std::runtime_error("launch file '" + path + "': " + e.what());
+  }
+  const auto sub = [&](const YAML::Node& n, const std::string& field) { return substitute(n.as<std::string>(), vars, path + ": " + field); };
+  LaunchSpec spec;
+  spec.name = root["name"] ? sub(root["name"], "name") : "run";
+  spec.lcm_url = root["lcm_url"] ? sub(root["lcm_url"], "lcm_url") : "";
+  if (root["record"]) spec.record_channels = sub(root["record"], "record");
+  if (root["grace_s"]) spec.grace_s = root["grace_s"].as<double>();
+  if (root["stop_when_exit"])
+    for (const auto& n : root["stop_when_exit"]) spec.stop_when_exit.push_back(n.as<std::string>());
+  if (!root["processes"] || !root["processes"].IsSequence() || root["processes"].size() == 0)
+    throw std::runtime_error("launch file '" + path + "': needs a non-empty 'processes' list");
+  for (const auto& p : root["processes"]) {
+    ProcessSpec proc;
+    if (!p["name"] || !p["command"] || !p["command"].IsSequence())
+      throw std::runtime_error("launch file '" + path + "': every process needs 'name' and a 'command' list");
+    proc.name = p["name"].as<std::string>();
+    for (const auto& arg : p["command"]) proc.command.push_back(sub(arg, proc.name + ".command"));
+    if (p["restart"]) proc.restart = parseRestart(p["restart"].as<std::string>(), path + ": " + proc.name);
+    spec.processes.push_back(std::move(proc));
+  }
+  for (const auto& name : spec.stop_when_exit) {
+    bool known = false;
+    for (const auto& p : spec.processes) known = known || p.name == name;
+    if (!known) throw std::runtime_error("launch file '" + path + "': stop_when_exit names unknown process '" + name + "'");
+  }
+  return spec;
+}
+
+}  // namespace adit::launch

@@ -1,0 +1,56 @@
+// `adit replay`: runs every pipeline stage that exists, in lockstep in one process, over an input log, as
+// fast as possible, and writes the run's products into one folder:
+//   output.lcmlog  every message the pipeline published (deterministic: byte-identical run after run)
+//   odometry.tum   poses before loop correction, one per sweep (when odometry/mapping exist)
+//   trajectory.tum final poses, one per sweep (loop-corrected when the loop closer exists)
+//   map.pcd        the map (when the mapper exists)
+//   timing.json    per-stage ms median/p95/max and peak memory (the only product that varies run to run)
+#pragma once
+
+#include "core/config.hpp"
+
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace adit::pipeline {
+
+struct ReplayOptions {
+  std::string input_log;
+  std::string out_dir;
+  Config config;
+  std::vector<std::string> stages;  // empty: every stage that is written
+  // Called now and then with the fraction of the input consumed (progress bars).
+  std::function<void(double)> on_progress;
+};
+
+struct StageTiming {
+  std::string stage;
+  std::size_t calls = 0;
+  double median_ms = 0, p95_ms = 0, max_ms = 0;
+};
+
+struct ReplayReport {
+  std::vector<std::string> stages_run;
+  std::vector<std::string> stages_missing;  // not written yet
+  std::int64_t input_events = 0;
+  std::int64_t output_events = 0;
+  std::int64_t corrupt_frames = 0;
+  bool truncated = false;
+  std::int64_t stage_errors = 0;  // errors + drops counted by the stages
+  std::int64_t sweeps = 0;        // poses in the trajectory
+  double sensor_seconds = 0;      // span of sensor time in the input
+  double wall_seconds = 0;
+  double peak_memory_mb = 0;
+  std::vector<StageTiming> timing;
+  std::vector<std::string> products;  // files written
+};
+
+// Throws std::runtime_error if the input cannot be read or the outputs cannot be written.
+ReplayReport runReplay(const ReplayOptions& options);
+
+// Peak resident memory of this process in MB (VmHWM), 0 if unknown.
+double peakMemoryMb();
+
+}  // namespace adit::pipeline

@@ -1,0 +1,28 @@
+// Command-line options of a lidar data source, shared by adit-lidar-bridge and `adit import`.
+#pragma once
+
+#include "runtime/source.hpp"
+
+#include <CLI/CLI.hpp>
+
+#include <memory>
+#include <string>
+
+namespace adit::sources {
+
+struct LidarSourceArgs {
+  std::string kind;   // "kitti" or "pcd"
+  std::string path;   // sequence folder or PCD folder
+  std::string channel = "LIDAR_POINTS";
+  // PCD only: sensor profile for rings by elevation when the files have no ring field.
+  std::string sensor = "vlp16";
+  int beams = 0;              // 0 = the profile's
+  double period_s = 0.1;      // sweep period when file names are not timestamps
+};
+
+// kind_positional: `adit import kitti <dir>` takes the kind as a positional; the bridge uses --source.
+void addLidarSourceOptions(CLI::App& app, LidarSourceArgs& args, bool kind_positional);
+// Throws std::runtime_error (unknown kind, unreadable folder).
+std::unique_ptr<runtime::MessageSource> makeLidarSource(const LidarSourceArgs& args);
+
+}  // namespace adit::sources

@@ -1,0 +1,20 @@
+// adit import kitti <sequence_dir> -o <log>   |   adit import pcd <dir> -o <log>
+#include "commands.hpp"
+
+#include "runtime/source.hpp"
+#include "sources/source_options.hpp"
+
+void registerImportCommand(CLI::App& app) {
+  auto source = std::make_shared<adit::sources::LidarSourceArgs>();
+  auto output = std::make_shared<std::string>();
+  auto* cmd = app.add_subcommand("import", "Convert a data set (KITTI odometry layout, PCD folder) into an LCM log");
+  addLidarSourceOptions(*cmd, *source, true);
+  cmd->add_option("-o,--output", *output, "LCM log to write")->required();
+  cmd->callback([source, output] {
+    adit::runtime::SourceRunOptions run;
+    run.process = "import";
+    run.output_log = *output;
+    auto src = adit::sources::makeLidarSource(*source);
+    if (const int code = adit::runtime::runSource(*src, run); code != 0) throw CLI::RuntimeError(code);
+  });
+}

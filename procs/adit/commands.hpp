@@ -1,0 +1,15 @@
+// Subcommands of the `adit` tool; each file registers one on the CLI11 app.
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+#include <string>
+
+void registerImportCommand(CLI::App& app);
+void registerReplayCommand(CLI::App& app);
+void registerLaunchCommand(CLI::App& app);
+void registerSpyCommand(CLI::App& app);
+void registerEvalCommand(CLI::App& app);
+
+// Folder of the running executable (build/bin), to find sibling programs and build/share.
+std::string executableDir();

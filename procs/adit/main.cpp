@@ -1,0 +1,33 @@
+// adit: the command-line tool (import data sets, replay logs through the pipeline, launch and supervise the
+// processes, open lcm-spy, evaluate trajectories). `adit <command> --help` documents each command.
+#include "commands.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include <filesystem>
+
+std::string executableDir() {
+  std::error_code ec;
+  const auto exe = std::filesystem::read_symlink("/proc/self/exe", ec);
+  return ec ? std::string(".") : exe.parent_path().string();
+}
+
+int main(int argc, char** argv) {
+  CLI::App app{"adit: real-time 3D mapping of underground roadways with a spinning lidar", "adit"};
+  app.require_subcommand(1);
+  spdlog::set_pattern("%H:%M:%S.%e %^%l%$ adit: %v");
+  registerImportCommand(app);
+  registerReplayCommand(app);
+  registerLaunchCommand(app);
+  registerSpyCommand(app);
+  registerEvalCommand(app);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  } catch (const std::exception& e) {
+    spdlog::error("{}", e.what());
+    return 1;
+  }
+  return 0;
+}
