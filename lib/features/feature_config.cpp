@@ -90,6 +90,7 @@ RansacConfig ransacFrom(const Config& c) {
   d.iterations = c.get(k + "iterations", d.iterations);
   d.inlier_threshold = c.get(k + "inlier_threshold", d.inlier_threshold);
   d.min_inliers = c.get(k + "min_inliers", d.min_inliers);
+  d.robust_scale = c.get(k + "robust_scale", d.robust_scale);
   d.seed = c.get(k + "seed", d.seed);
   return d;
 }

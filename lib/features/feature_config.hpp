@@ -138,6 +138,9 @@ struct RansacConfig {
   float inlier_threshold = 0.5f;
   // features.ransac.min_inliers: fewer inliers means no reliable transform (ok = false).
   int min_inliers = 5;
+  // features.ransac.robust_scale (m): Cauchy scale of the final weighted refit. Centroids that agree to
+  // centimetres dominate; a centroid 0.3 m off (its cluster cut differently in the other sweep) gets weight 0.1.
+  float robust_scale = 0.1f;
   // features.ransac.seed: fixed seed of the hypothesis sampler (results are deterministic).
   std::uint32_t seed = 42;
 };

@@ -32,10 +32,11 @@ struct Cluster {
   Eigen::Vector3d mean() const { return sum / count; }
 };
 
+// Same object: similar horizontal range and horizontal means close. The reference code compares |dx| and
+// |dy| separately, which depends on the sensor's yaw; the horizontal distance does not.
 bool similar(const Cluster& a, const Cluster& b, float radial_tol, float xy_tol) {
   const Eigen::Vector3d ma = a.mean(), mb = b.mean();
-  return std::fabs(a.meanRxy() - b.meanRxy()) < radial_tol && std::fabs(ma.x() - mb.x()) < xy_tol &&
-         std::fabs(ma.y() - mb.y()) < xy_tol;
+  return std::fabs(a.meanRxy() - b.meanRxy()) < radial_tol && std::hypot(ma.x() - mb.x(), ma.y() - mb.y()) < xy_tol;
 }
 
 // Edge points of each horizontal sector, in cloud order (ring by ring, firing order).

@@ -1,6 +1,6 @@
 #include "features/link3d_match.hpp"
 
-#include <Eigen/Geometry>
+#include <Eigen/SVD>
 
 #include <algorithm>
 #include <cmath>
@@ -39,14 +39,28 @@ std::vector<LinK3dMatch> matchLinK3d(const FeatureSet& a, const FeatureSet& b, c
 }
 
 Eigen::Isometry3d features::fitRigid(const std::vector<Eigen::Vector3f>& ka, const std::vector<Eigen::Vector3f>& kb,
-                           const std::vector<LinK3dMatch>& pairs) {
-  Eigen::Matrix3Xd src(3, pairs.size()), dst(3, pairs.size());
-  for (std::size_t k = 0; k < pairs.size(); ++k) {
-    src.col(k) = kb[pairs[k].b].cast<double>();
-    dst.col(k) = ka[pairs[k].a].cast<double>();
-  }
+                                     const std::vector<LinK3dMatch>& pairs, const std::vector<double>& weights) {
   Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  if (pairs.size() >= 3) T.matrix() = Eigen::umeyama(src, dst, false);
+  if (pairs.size() < 3) return T;
+  const auto w = [&](std::size_t k) { return weights.empty() ? 1.0 : weights[k]; };
+  double wsum = 0.0;
+  Eigen::Vector3d ca = Eigen::Vector3d::Zero(), cb = Eigen::Vector3d::Zero();
+  for (std::size_t k = 0; k < pairs.size(); ++k) {
+    wsum += w(k);
+    ca += w(k) * ka[pairs[k].a].cast<double>();
+    cb += w(k) * kb[pairs[k].b].cast<double>();
+  }
+  if (!(wsum > 0.0)) return T;
+  ca /= wsum;
+  cb /= wsum;
+  Eigen::Matrix3d H = Eigen::Matrix3d::Zero();  // weighted cross-covariance, b -> a
+  for (std::size_t k = 0; k < pairs.size(); ++k)
+    H += w(k) * (kb[pairs[k].b].cast<double>() - cb) * (ka[pairs[k].a].cast<double>() - ca).transpose();
+  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(H, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Eigen::Matrix3d D = Eigen::Matrix3d::Identity();
+  D(2, 2) = (svd.matrixV() * svd.matrixU().transpose()).determinant() < 0.0 ? -1.0 : 1.0;  // no reflection
+  T.linear() = svd.matrixV() * D * svd.matrixU().transpose();
+  T.translation() = ca - T.linear() * cb;
   return T;
 }
 
@@ -92,16 +106,19 @@ RansacResult estimateTransformRansac(const std::vector<Eigen::Vector3f>& ka, con
     }
   }
   if (best.inliers.size() < 3) return RansacResult{};
-  for (int refine = 0; refine < 10; ++refine) {  // least squares on the inliers until they stop changing
-    const Eigen::Isometry3d T = features::fitRigid(ka, kb, best.inliers);
+  // Refinement: the consensus set is refitted with Cauchy weights w = 1 / (1 + (r / robust_scale)^2), so the
+  // few centroids that moved (a cluster cut differently in the other sweep) barely pull on the result.
+  for (int iteration = 0; iteration < 10; ++iteration) {
+    std::vector<double> weights;
+    for (const LinK3dMatch& m : best.inliers) {
+      const double r = (best.T_a_b * kb[m.b].cast<double>() - ka[m.a].cast<double>()).norm() / std::max(1e-3, static_cast<double>(cfg.robust_scale));
+      weights.push_back(1.0 / (1.0 + r * r));
+    }
+    const Eigen::Isometry3d T = features::fitRigid(ka, kb, best.inliers, weights);
     std::vector<LinK3dMatch> in = inliersOf(T, ka, kb, matches, cfg.inlier_threshold);
     if (in.size() < 3) break;
     best.T_a_b = T;
-    const bool same = in.size() == best.inliers.size() &&
-                      std::equal(in.begin(), in.end(), best.inliers.begin(),
-                                 [](const LinK3dMatch& x, const LinK3dMatch& y) { return x.a == y.a && x.b == y.b; });
     best.inliers = std::move(in);
-    if (same) break;
   }
   double sum2 = 0.0;
   for (const LinK3dMatch& m : best.inliers) sum2 += (best.T_a_b * kb[m.b].cast<double>() - ka[m.a].cast<double>()).squaredNorm();

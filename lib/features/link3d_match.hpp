@@ -32,16 +32,17 @@ struct RansacResult {
 };
 
 // Rigid transform from matched keypoints: 3-point hypotheses drawn by a seeded std::mt19937, the one with
-// most inliers (ties: first found) refitted by least squares on its inliers until the set stops changing.
-// Deterministic for given inputs and seed.
+// most inliers (ties: first found) refined by robustly weighted least squares on its inliers (see
+// RansacConfig::robust_scale). Deterministic for given inputs and seed.
 RansacResult estimateTransformRansac(const std::vector<Eigen::Vector3f>& keypoints_a,
                                      const std::vector<Eigen::Vector3f>& keypoints_b,
                                      const std::vector<LinK3dMatch>& matches, const RansacConfig& cfg);
 
 namespace features {
-// Least-squares rigid transform (Umeyama / Kabsch, no scale) with p_a ~ T * p_b over the given pairs.
+// Weighted least-squares rigid transform (Kabsch, no scale) with p_a ~ T * p_b over the given pairs;
+// empty weights = all 1. Identity if fewer than 3 pairs.
 Eigen::Isometry3d fitRigid(const std::vector<Eigen::Vector3f>& keypoints_a, const std::vector<Eigen::Vector3f>& keypoints_b,
-                           const std::vector<LinK3dMatch>& pairs);
+                           const std::vector<LinK3dMatch>& pairs, const std::vector<double>& weights = {});
 
 }  // namespace features
 }  // namespace adit
