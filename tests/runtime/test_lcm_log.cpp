@@ -1,0 +1,102 @@
+// LCM log files: round trip, and corrupt or truncated logs skipped with counts instead of failing.
+#include "runtime/lcm_log.hpp"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+namespace fs = std::filesystem;
+using adit::runtime::LogEvent;
+using adit::runtime::LogReader;
+using adit::runtime::LogWriter;
+
+namespace {
+
+fs::path tempPath(const std::string& name) {
+  const fs::path dir = fs::temp_directory_path() / ("adit_test_lcm_log_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  return dir / name;
+}
+
+std::vector<std::uint8_t> payload(int i) { return std::vector<std::uint8_t>(static_cast<std::size_t>(10 + i), static_cast<std::uint8_t>(i)); }
+
+void writeLog(const fs::path& path, int n) {
+  LogWriter w(path.string());
+  for (int i = 0; i < n; ++i) w.write(i % 2 ? "IMU" : "LIDAR_POINTS", payload(i), 1000 * i);
+  w.close();
+}
+
+std::vector<LogEvent> readAll(LogReader& r) {
+  std::vector<LogEvent> out;
+  LogEvent e;
+  while (r.next(e)) out.push_back(e);
+  return out;
+}
+
+std::string slurp(const fs::path& p) {
+  std::ifstream f(p, std::ios::binary);
+  return {std::istreambuf_iterator<char>(f), {}};
+}
+
+}  // namespace
+
+TEST(LcmLog, RoundTripKeepsChannelsTimesAndPayloads) {
+  const auto path = tempPath("round.lcmlog");
+  writeLog(path, 5);
+  EXPECT_FALSE(fs::exists(path.string() + ".tmp." + std::to_string(::getpid())));  // renamed into place
+  LogReader r(path.string());
+  const auto events = readAll(r);
+  ASSERT_EQ(events.size(), 5u);
+  for (int i = 0; i < 5; ++i) {
+    EXPECT_EQ(events[i].event_number, i);
+    EXPECT_EQ(events[i].timestamp, 1000 * i);
+    EXPECT_EQ(events[i].channel, i % 2 ? "IMU" : "LIDAR_POINTS");
+    EXPECT_EQ(events[i].data, payload(i));
+  }
+  EXPECT_EQ(r.corruptFrames(), 0);
+  EXPECT_FALSE(r.truncated());
+}
+
+TEST(LcmLog, CorruptFrameInTheMiddleIsSkippedAndCounted) {
+  const auto path = tempPath("corrupt.lcmlog");
+  writeLog(path, 5);
+  std::string bytes = slurp(path);
+  // Frame 2 starts after frames 0 and 1: header 28 bytes + channel + data each.
+  const std::size_t frame2 = (28 + 12 + 10) + (28 + 3 + 11);
+  bytes[frame2 + 22] = '\x7f';  // channel length of frame 2 becomes absurd
+  std::ofstream(path, std::ios::binary | std::ios::trunc) << bytes;
+  LogReader r(path.string());
+  const auto events = readAll(r);
+  ASSERT_EQ(events.size(), 4u);
+  EXPECT_EQ(events[2].event_number, 3);  // 0, 1, (2 lost), 3, 4
+  EXPECT_EQ(r.corruptFrames(), 1);
+}
+
+TEST(LcmLog, TruncatedTailEndsTheLogWithAFlag) {
+  const auto path = tempPath("truncated.lcmlog");
+  writeLog(path, 5);
+  const std::string bytes = slurp(path);
+  std::ofstream(path, std::ios::binary | std::ios::trunc) << bytes.substr(0, bytes.size() - 7);
+  LogReader r(path.string());
+  EXPECT_EQ(readAll(r).size(), 4u);
+  EXPECT_TRUE(r.truncated());
+}
+
+TEST(LcmLog, GarbageFileYieldsNothingAndDoesNotThrow) {
+  const auto path = tempPath("garbage.lcmlog");
+  std::string junk(5000, '\0');
+  for (std::size_t i = 0; i < junk.size(); ++i) junk[i] = static_cast<char>((i * 7919) % 251);
+  std::ofstream(path, std::ios::binary | std::ios::trunc) << junk;
+  LogReader r(path.string());
+  EXPECT_TRUE(readAll(r).empty());
+}
+
+TEST(LcmLog, MissingFileThrowsAClearError) {
+  try {
+    LogReader r("/nonexistent/adit.lcmlog");
+    FAIL() << "expected an exception";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("/nonexistent/adit.lcmlog"), std::string::npos);
+  }
+}
