@@ -9,7 +9,6 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
-#include <sstream>
 
 #include "io/atomic_file.hpp"
 #include "io/rings.hpp"
