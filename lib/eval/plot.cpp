@@ -1,7 +1,6 @@
 #include "eval/plot.hpp"
 
-#include <pcl/io/pcd_io.h>
-#include <pcl/point_types.h>
+#include "io/pcd.hpp"
 
 #include <fcntl.h>
 #include <spawn.h>
@@ -167,11 +166,15 @@ PlotResult plotMapTopView(const std::vector<Eigen::Vector3f>& points, const std:
 PlotResult plotMapTopViewFromPcd(const std::string& pcd_path, const std::string& png_path,
                                  const Trajectory& trajectory, const PlotOptions& options) {
   if (!fileExists(pcd_path)) return {false, pcd_path + ": no such file"};
-  pcl::PointCloud<pcl::PointXYZ> cloud;
-  if (pcl::io::loadPCDFile<pcl::PointXYZ>(pcd_path, cloud) != 0) return {false, pcd_path + ": not a readable PCD file"};
   std::vector<Eigen::Vector3f> points;
-  points.reserve(cloud.size());
-  for (const pcl::PointXYZ& p : cloud.points) points.emplace_back(p.x, p.y, p.z);
+  try {
+    // lib/io validates the header and body size first (PCL itself can crash on a corrupt file).
+    const LidarScan cloud = io::readPcdScan(pcd_path, io::PcdFolderConfig{}, 0, 0);
+    points.reserve(cloud.points.size());
+    for (const LidarPoint& p : cloud.points) points.push_back(p.p);
+  } catch (const std::exception& e) {
+    return {false, e.what()};
+  }
   return plotMapTopView(points, png_path, trajectory, options);
 }
 

@@ -33,7 +33,8 @@ PlotResult plotTrajectory(const EvalResult& result, const std::string& png_path,
 // Top view of a map point cloud as a density image, optionally with a trajectory drawn over it.
 PlotResult plotMapTopView(const std::vector<Eigen::Vector3f>& points, const std::string& png_path,
                           const Trajectory& trajectory = {}, const PlotOptions& options = {});
-// Same, reading the cloud from a PCD file (any point type with x, y, z).
+// Same, reading the cloud from a PCD file (any point type with x, y, z; read by lib/io, which rejects
+// corrupt files with a message instead of crashing).
 PlotResult plotMapTopViewFromPcd(const std::string& pcd_path, const std::string& png_path,
                                  const Trajectory& trajectory = {}, const PlotOptions& options = {});
 

@@ -84,6 +84,13 @@ TEST(Plot, MissingPythonOrBadInputIsAnErrorNotACrash) {
   EXPECT_FALSE(plotTrajectory(EvalResult{}, test::tempPath("x.png")).ok);
   EXPECT_FALSE(plotMapTopView({}, test::tempPath("x.png")).ok);
   EXPECT_FALSE(plotMapTopViewFromPcd("/nonexistent.pcd", test::tempPath("x.png")).ok);
+  const std::string garbage = test::tempPath("garbage.pcd");
+  std::ofstream(garbage) << "VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH 100\n"
+                            "HEIGHT 1\nPOINTS 100\nDATA binary\nshort";
+  const PlotResult corrupt = plotMapTopViewFromPcd(garbage, test::tempPath("x.png"));
+  EXPECT_FALSE(corrupt.ok);
+  EXPECT_FALSE(corrupt.message.empty());
+  std::remove(garbage.c_str());
 
   // The script's own failure (unwritable output) comes back with its stderr.
   const PlotResult unwritable = plotTrajectory(noisyResult(), "/nonexistent/dir/x.png");
