@@ -1,0 +1,133 @@
+#include "mapping/scan_to_map.hpp"
+
+#include "mapping/downsample.hpp"
+#include "odometry/feature_fit.hpp"
+#include "odometry/pose_increment.hpp"
+
+namespace adit {
+namespace {
+
+std::vector<Eigen::Vector3d> toDouble(const std::vector<LidarPoint>& points) {
+  std::vector<Eigen::Vector3d> out;
+  out.reserve(points.size());
+  for (const LidarPoint& p : points) out.push_back(p.p.cast<double>());
+  return out;
+}
+
+std::vector<Eigen::Vector3d> transformed(const std::vector<Eigen::Vector3d>& points, const Eigen::Isometry3d& T) {
+  std::vector<Eigen::Vector3d> out;
+  out.reserve(points.size());
+  for (const auto& p : points) out.push_back(T * p);
+  return out;
+}
+
+}  // namespace
+
+MapperConfig mapperConfigFrom(const Config& c) {
+  MapperConfig m;
+  m.registration = registrationConfigFrom(c, "mapping");
+  m.outer_iterations = c.get<int>("mapping.outer_iterations", m.outer_iterations);
+  m.corner_resolution_m = c.get<double>("mapping.corner_resolution_m", m.corner_resolution_m);
+  m.surf_resolution_m = c.get<double>("mapping.surf_resolution_m", m.surf_resolution_m);
+  m.map_voxel_size_m = c.get<double>("mapping.map_voxel_size_m", m.map_voxel_size_m);
+  m.max_points_per_voxel = c.get<int>("mapping.max_points_per_voxel", m.max_points_per_voxel);
+  m.neighbours = c.get<int>("mapping.neighbours", m.neighbours);
+  m.max_neighbour_distance_m = c.get<double>("mapping.max_neighbour_distance_m", m.max_neighbour_distance_m);
+  m.line_eigen_ratio = c.get<double>("mapping.line_eigen_ratio", m.line_eigen_ratio);
+  m.plane_max_point_distance_m = c.get<double>("mapping.plane_max_point_distance_m", m.plane_max_point_distance_m);
+  m.local_map_radius_m = c.get<double>("mapping.local_map_radius_m", m.local_map_radius_m);
+  m.global_map_resolution_m = c.get<double>("mapping.global_map_resolution_m", m.global_map_resolution_m);
+  m.global_map_max_range_m = c.get<double>("mapping.global_map_max_range_m", m.global_map_max_range_m);
+  return m;
+}
+
+ScanToMapMapper::ScanToMapMapper(MapperConfig config)
+    : config_(std::move(config)),
+      corner_map_(config_.map_voxel_size_m, config_.corner_resolution_m, config_.max_points_per_voxel),
+      surf_map_(config_.map_voxel_size_m, config_.surf_resolution_m, config_.max_points_per_voxel),
+      global_map_(config_.global_map_resolution_m) {}
+
+Correspondences ScanToMapMapper::match(const std::vector<Eigen::Vector3d>& corners,
+                                       const std::vector<Eigen::Vector3d>& surfs, const Eigen::Isometry3d& T) const {
+  Correspondences m;
+  const int k = std::max(3, config_.neighbours);
+  for (const Eigen::Vector3d& p : corners) {
+    const auto near = corner_map_.nearest(T * p, k, config_.max_neighbour_distance_m);
+    if (static_cast<int>(near.size()) < k) continue;
+    if (const auto line = fitLine(near, config_.line_eigen_ratio)) m.lines.push_back({p, line->centroid, line->direction});
+  }
+  for (const Eigen::Vector3d& p : surfs) {
+    const auto near = surf_map_.nearest(T * p, k, config_.max_neighbour_distance_m);
+    if (static_cast<int>(near.size()) < k) continue;
+    if (const auto plane = fitPlane(near, config_.plane_max_point_distance_m))
+      m.planes.push_back({p, plane->normal, plane->offset});
+  }
+  return m;
+}
+
+void ScanToMapMapper::addToMaps(const FeatureSet& f, const std::vector<Eigen::Vector3d>& corners,
+                                const std::vector<Eigen::Vector3d>& surfs, const Eigen::Isometry3d& T) {
+  corner_map_.insert(transformed(corners, T));
+  surf_map_.insert(transformed(surfs, T));
+  corner_map_.removeFarFrom(T.translation(), config_.local_map_radius_m);
+  surf_map_.removeFarFrom(T.translation(), config_.local_map_radius_m);
+  std::vector<Eigen::Vector3f> cloud;
+  cloud.reserve(f.cloud.points.size());
+  for (const LidarPoint& p : f.cloud.points) cloud.push_back(p.p);
+  global_map_.insert(cloud, T, config_.global_map_max_range_m);
+}
+
+PoseEstimate ScanToMapMapper::process(const FeatureSet& f, const PoseEstimate& odometry) {
+  PoseEstimate out;
+  out.utime = f.utime;
+  if (corrected_) out.flags |= PoseEstimate::kLoopCorrected;
+  corrected_ = false;
+  const Eigen::Isometry3d odom = isFinitePose(odometry.pose) ? odometry.pose : Eigen::Isometry3d::Identity();
+  const Eigen::Isometry3d predicted = T_map_odom_ * odom;
+  const auto corners = voxelDownsample(toDouble(f.corner_less_sharp), config_.corner_resolution_m);
+  const auto surfs = voxelDownsample(toDouble(f.surf_less_flat), config_.surf_resolution_m);
+
+  const bool first = corner_map_.empty() && surf_map_.empty();
+  Eigen::Isometry3d T = predicted;
+  bool ok = !first;
+  RegistrationResult r;
+  for (int round = 0; ok && round < std::max(1, config_.outer_iterations); ++round) {
+    r = registerStep(match(corners, surfs, T), T, predicted, config_.registration);
+    ok = r.ok;
+    out.iterations += r.iterations;
+    if (!ok) break;
+    const bool converged = hasConverged(T, r.pose);
+    T = r.pose;
+    if (converged) break;
+  }
+  if (ok) {
+    out.covariance = covarianceFrom(r.information, r.degeneracy, config_.registration.prior_sigma_translation_m,
+                                    config_.registration.prior_sigma_rotation_rad);
+    out.translation_eigenvalues = r.degeneracy.translation_eigenvalues;
+    out.rotation_eigenvalues = r.degeneracy.rotation_eigenvalues;
+    out.flags |= r.degeneracy.flags;
+    out.final_cost = r.final_cost;
+  } else {
+    T = predicted;
+    out.covariance = odometry.covariance;
+    if (!first) out.flags |= PoseEstimate::kRegistrationFailed;
+  }
+  T_map_odom_ = T * odom.inverse();
+  addToMaps(f, corners, surfs, T);
+  out.pose = T;
+  return out;
+}
+
+void ScanToMapMapper::applyCorrection(const Eigen::Isometry3d& T_corrected_uncorrected) {
+  if (!isFinitePose(T_corrected_uncorrected)) return;
+  T_map_odom_ = T_corrected_uncorrected * T_map_odom_;
+  corner_map_.transform(T_corrected_uncorrected);
+  surf_map_.transform(T_corrected_uncorrected);
+  corrected_ = true;
+}
+
+std::vector<Eigen::Vector3f> ScanToMapMapper::globalMap(double voxel_size) const {
+  return global_map_.points(voxel_size);
+}
+
+}  // namespace adit

@@ -1,0 +1,81 @@
+// Scan-to-map refinement (A-LOAM laserMapping with an incremental local map): each sweep's edge and surface
+// points are registered against corner and surface voxel maps around the robot, then inserted into them.
+// The odometry pose only seeds the estimate, through the drift correction T_map_odom. Degenerate directions
+// are held to the odometry prediction. Every sweep is processed; nothing is dropped.
+#pragma once
+
+#include "core/config.hpp"
+#include "core/types.hpp"
+#include "mapping/global_map.hpp"
+#include "mapping/voxel_map.hpp"
+#include "odometry/correspondences.hpp"
+#include "odometry/registration.hpp"
+
+namespace adit {
+
+struct MapperConfig {
+  RegistrationConfig registration;  // keys "mapping.<field>" (see registration.hpp)
+  // Correspondence rounds per sweep (A-LOAM: 2, each with a fresh neighbour search).
+  int outer_iterations = 2;
+  // Resolution of edge / surface points, for both the current sweep and the map (m). A-LOAM's VLP-16 values;
+  // 0.4 / 0.8 suit 64-beam data.
+  double corner_resolution_m = 0.2;
+  double surf_resolution_m = 0.4;
+  // Local-map voxel edge (m). Neighbour search looks at the 27 voxels around a point, so this is also the
+  // largest neighbour distance that is searched exactly.
+  double map_voxel_size_m = 1.0;
+  int max_points_per_voxel = 20;
+  // Neighbours per feature and their largest distance (A-LOAM: 5 within 1 m).
+  int neighbours = 5;
+  double max_neighbour_distance_m = 1.0;
+  // Edge if largest eigenvalue > ratio * second (A-LOAM: 3); plane rejected if a neighbour is farther than
+  // this from it (A-LOAM: 0.2 m).
+  double line_eigen_ratio = 3.0;
+  double plane_max_point_distance_m = 0.2;
+  // Map points farther than this from the robot are dropped (m): bounds memory on long runs. 16-beam
+  // roadway returns are mostly within 50 m; KITTI needs ~80 m.
+  double local_map_radius_m = 80.0;
+  // Resolution of the saved global map (m) and the range of sweep points folded into it (m).
+  double global_map_resolution_m = 0.1;
+  double global_map_max_range_m = 60.0;
+};
+
+// Reads "mapping.*" keys with the defaults above.
+MapperConfig mapperConfigFrom(const Config& c);
+
+class ScanToMapMapper {
+ public:
+  explicit ScanToMapMapper(MapperConfig config = {});
+
+  // Refines the sweep's pose against the local map, then adds the sweep to the maps. `odometry` is the
+  // odometry estimate T_odom_lidar for f.utime. Returns T_world_lidar. Never throws; a sweep that cannot be
+  // registered keeps the odometry prediction and is flagged kRegistrationFailed.
+  PoseEstimate process(const FeatureSet& f, const PoseEstimate& odometry);
+
+  // A loop closure moved the trajectory: T_corrected_uncorrected is applied to the local map and to every
+  // future pose. The global map keeps points where they were registered (rebuilding it from corrected
+  // keyframes is the loop closer's job).
+  void applyCorrection(const Eigen::Isometry3d& T_corrected_uncorrected);
+
+  // The global map downsampled to voxel_size (m), deterministic order: what map.pcd holds.
+  std::vector<Eigen::Vector3f> globalMap(double voxel_size) const;
+
+  const VoxelMap& cornerMap() const { return corner_map_; }
+  const VoxelMap& surfMap() const { return surf_map_; }
+  const Eigen::Isometry3d& mapFromOdometry() const { return T_map_odom_; }
+
+ private:
+  Correspondences match(const std::vector<Eigen::Vector3d>& corners, const std::vector<Eigen::Vector3d>& surfs,
+                        const Eigen::Isometry3d& T_world_lidar) const;
+  void addToMaps(const FeatureSet& f, const std::vector<Eigen::Vector3d>& corners,
+                 const std::vector<Eigen::Vector3d>& surfs, const Eigen::Isometry3d& T_world_lidar);
+
+  MapperConfig config_;
+  VoxelMap corner_map_;
+  VoxelMap surf_map_;
+  GlobalMap global_map_;
+  Eigen::Isometry3d T_map_odom_ = Eigen::Isometry3d::Identity();  // drift correction of the odometry
+  bool corrected_ = false;  // a correction arrived since the last output (flag it once)
+};
+
+}  // namespace adit

@@ -1,0 +1,46 @@
+// The mapper's local map: points in a voxel hash (KISS-ICP style), updated incrementally every sweep and
+// trimmed to a radius around the robot, so nothing is rebuilt per sweep and memory stays bounded.
+//
+// Determinism: results never depend on hash iteration order. Queries are lookups of the 27 voxels around a
+// point, each voxel's points kept in insertion order; removal erases a set that does not depend on order;
+// whole-map listings are sorted by voxel key.
+#pragma once
+
+#include "mapping/voxel_key.hpp"
+
+#include <Eigen/Geometry>
+
+#include <unordered_map>
+#include <vector>
+
+namespace adit {
+
+class VoxelMap {
+ public:
+  // voxel_size: cell edge (m), also the largest exact neighbour-search radius. min_spacing: a new point closer
+  // than this to a point of its voxel is dropped (map resolution). max_points_per_voxel bounds density.
+  VoxelMap(double voxel_size, double min_spacing, int max_points_per_voxel);
+
+  void insert(const std::vector<Eigen::Vector3d>& points);
+  // Drops every voxel whose centre is farther than radius from centre.
+  void removeFarFrom(const Eigen::Vector3d& centre, double radius);
+  // Moves every point by T (a loop-closure correction) and re-hashes.
+  void transform(const Eigen::Isometry3d& T);
+
+  // Up to k nearest points within max_distance (<= voxel size for exactness), nearest first.
+  std::vector<Eigen::Vector3d> nearest(const Eigen::Vector3d& q, int k, double max_distance) const;
+
+  std::vector<Eigen::Vector3d> points() const;  // sorted by voxel key
+  std::size_t numPoints() const { return num_points_; }
+  std::size_t numVoxels() const { return voxels_.size(); }
+  bool empty() const { return num_points_ == 0; }
+  double voxelSize() const { return voxel_size_; }
+
+ private:
+  double voxel_size_, min_spacing_sq_;
+  int max_points_per_voxel_;
+  std::size_t num_points_ = 0;
+  std::unordered_map<VoxelKey, std::vector<Eigen::Vector3d>, VoxelKeyHash> voxels_;
+};
+
+}  // namespace adit

@@ -1,0 +1,134 @@
+#include "odometry/registration.hpp"
+
+#include "odometry/pose_increment.hpp"
+#include "odometry/residuals.hpp"
+
+#include <ceres/ceres.h>
+
+#include <memory>
+
+namespace adit {
+namespace {
+
+std::unique_ptr<ceres::LossFunction> makeLoss(const RegistrationConfig& c) {
+  if (c.loss == "cauchy") return std::make_unique<ceres::CauchyLoss>(c.loss_scale_m);
+  if (c.loss == "none") return nullptr;
+  return std::make_unique<ceres::HuberLoss>(c.loss_scale_m);
+}
+
+// Adds one residual block per correspondence, with the geometry moved into the frame of T0.
+std::vector<ceres::ResidualBlockId> addMeasurements(ceres::Problem& problem, double* xi, const Correspondences& m,
+                                                    const Eigen::Isometry3d& T0, ceres::LossFunction* loss) {
+  std::vector<ceres::ResidualBlockId> ids;
+  ids.reserve(m.size());
+  const Eigen::Isometry3d T0_inv = T0.inverse();
+  for (const LineMatch& l : m.lines) {
+    auto* f = new PointToLineResidual{l.point, T0_inv * l.on_line, T0_inv.linear() * l.direction};
+    ids.push_back(problem.AddResidualBlock(new ceres::AutoDiffCostFunction<PointToLineResidual, 3, 6>(f), loss, xi));
+  }
+  for (const PlaneMatch& p : m.planes) {
+    const Eigen::Vector3d n = T0.linear().transpose() * p.normal;
+    auto* f = new PointToPlaneResidual{p.point, n, p.normal.dot(T0.translation()) + p.offset};
+    ids.push_back(problem.AddResidualBlock(new ceres::AutoDiffCostFunction<PointToPlaneResidual, 1, 6>(f), loss, xi));
+  }
+  return ids;
+}
+
+// J^T J / sigma^2 of the given residual blocks at the current parameter value (robust weights applied).
+Matrix6d informationOf(ceres::Problem& problem, const std::vector<ceres::ResidualBlockId>& ids, double sigma) {
+  ceres::Problem::EvaluateOptions options;
+  options.residual_blocks = ids;
+  options.apply_loss_function = true;
+  options.num_threads = 1;
+  ceres::CRSMatrix J;
+  Matrix6d H = Matrix6d::Zero();
+  if (ids.empty() || !problem.Evaluate(options, nullptr, nullptr, nullptr, &J)) return H;
+  for (int row = 0; row < J.num_rows; ++row) {
+    Vector6d g = Vector6d::Zero();
+    for (int k = J.rows[row]; k < J.rows[row + 1]; ++k) g[J.cols[k]] = J.values[k];
+    H.noalias() += g * g.transpose();
+  }
+  return H / (sigma * sigma);
+}
+
+// Residuals holding each degenerate eigen-direction of a block to the prior increment.
+void addDirectionalPriors(ceres::Problem& problem, double* xi, const DegeneracyReport& d, const Vector6d& target,
+                          const RegistrationConfig& c) {
+  for (int block = 0; block < 2; ++block) {
+    const auto& degenerate = block == 0 ? d.translation_degenerate : d.rotation_degenerate;
+    const Eigen::Matrix3d& dirs = block == 0 ? d.translation_directions : d.rotation_directions;
+    const double largest = block == 0 ? d.translation_eigenvalues[2] : d.rotation_eigenvalues[2];
+    if (!(largest > 0.0)) continue;  // nothing observed at all: the solver will not move xi anyway
+    for (int i = 0; i < 3; ++i) {
+      if (!degenerate[i]) continue;
+      Vector6d v = Vector6d::Zero();
+      v.segment<3>(3 * block) = dirs.col(i);
+      // Residuals are in metres with implicit sigma = point_sigma; weight^2 / sigma^2 = strength * largest.
+      const double weight = std::sqrt(c.degeneracy_prior_strength * largest) * c.point_sigma_m;
+      problem.AddResidualBlock(new ceres::AutoDiffCostFunction<DirectionalPriorResidual, 1, 6>(
+                                   new DirectionalPriorResidual{v, target, weight}),
+                               nullptr, xi);
+    }
+  }
+}
+
+}  // namespace
+
+RegistrationConfig registrationConfigFrom(const Config& c, const std::string& prefix) {
+  RegistrationConfig r;
+  const auto key = [&](const char* name) { return prefix + "." + name; };
+  r.max_solver_iterations = c.get<int>(key("max_solver_iterations"), r.max_solver_iterations);
+  r.loss = c.get<std::string>(key("loss"), r.loss);
+  r.loss_scale_m = c.get<double>(key("loss_scale_m"), r.loss_scale_m);
+  r.min_correspondences = c.get<int>(key("min_correspondences"), r.min_correspondences);
+  r.point_sigma_m = c.get<double>(key("point_sigma_m"), r.point_sigma_m);
+  r.degeneracy_ratio = c.get<double>(key("degeneracy_ratio"), r.degeneracy_ratio);
+  r.degeneracy_prior = c.get<bool>(key("degeneracy_prior"), r.degeneracy_prior);
+  r.degeneracy_prior_strength = c.get<double>(key("degeneracy_prior_strength"), r.degeneracy_prior_strength);
+  r.prior_sigma_translation_m = c.get<double>(key("prior_sigma_translation_m"), r.prior_sigma_translation_m);
+  r.prior_sigma_rotation_rad = c.get<double>(key("prior_sigma_rotation_rad"), r.prior_sigma_rotation_rad);
+  return r;
+}
+
+RegistrationResult registerStep(const Correspondences& matches, const Eigen::Isometry3d& T0,
+                                const Eigen::Isometry3d& motion_prior, const RegistrationConfig& config) {
+  RegistrationResult result;
+  result.pose = T0;
+  result.num_correspondences = static_cast<int>(matches.size());
+  if (!isFinitePose(T0) || result.num_correspondences < std::max(1, config.min_correspondences)) return result;
+
+  double xi[6] = {0, 0, 0, 0, 0, 0};
+  ceres::Problem::Options problem_options;
+  problem_options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  ceres::Problem problem(problem_options);
+  const std::unique_ptr<ceres::LossFunction> loss = makeLoss(config);
+  const auto ids = addMeasurements(problem, xi, matches, T0, loss.get());
+
+  // Degeneracy at the linearisation point decides where the motion prior applies during this round.
+  const Matrix6d H0 = informationOf(problem, ids, config.point_sigma_m);
+  const DegeneracyReport d0 = analyzeDegeneracy(H0, config.degeneracy_ratio);
+  if (config.degeneracy_prior && d0.flags != 0 && isFinitePose(motion_prior))
+    addDirectionalPriors(problem, xi, d0, incrementBetween(T0, motion_prior), config);
+
+  ceres::Solver::Options options;
+  options.linear_solver_type = ceres::DENSE_QR;
+  options.max_num_iterations = std::max(1, config.max_solver_iterations);
+  options.num_threads = 1;
+  options.logging_type = ceres::SILENT;
+  options.minimizer_progress_to_stdout = false;
+  ceres::Solver::Summary summary;
+  ceres::Solve(options, &problem, &summary);
+
+  const Vector6d solution = Eigen::Map<const Vector6d>(xi);
+  if (!solution.allFinite()) return result;
+  // Report information and degeneracy at the solution, from the measurements only.
+  result.information = informationOf(problem, ids, config.point_sigma_m);
+  result.degeneracy = analyzeDegeneracy(result.information, config.degeneracy_ratio);
+  result.pose = applyIncrement(T0, solution);
+  result.iterations = static_cast<int>(summary.iterations.size());
+  result.final_cost = summary.final_cost;
+  result.ok = isFinitePose(result.pose);
+  return result;
+}
+
+}  // namespace adit

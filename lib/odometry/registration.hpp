@@ -1,0 +1,58 @@
+// One Gauss-Newton round of point-to-line / point-to-plane registration with Ceres, shared by scan-to-scan
+// odometry and scan-to-map mapping. The caller finds correspondences at a linearisation pose T0, this solves
+// for the pose, measures degeneracy from the Jacobian and, if asked, holds degenerate directions to a
+// motion-model prior. The caller recomputes correspondences at the new pose and calls again (outer loop).
+#pragma once
+
+#include "core/config.hpp"
+#include "core/types.hpp"
+#include "odometry/correspondences.hpp"
+#include "odometry/degeneracy.hpp"
+
+#include <string>
+
+namespace adit {
+
+struct RegistrationConfig {
+  // Ceres iterations per outer round. Correspondences are fixed inside a round, so a few suffice.
+  int max_solver_iterations = 5;
+  // Robust loss: "huber", "cauchy" or "none"; scale in metres of residual. 0.1 m is A-LOAM's Huber scale:
+  // residuals beyond ~10 cm (wrong correspondences, moving objects) lose influence.
+  std::string loss = "huber";
+  double loss_scale_m = 0.1;
+  // Fewer correspondences than this and the round is declared failed (the pose is not trusted).
+  int min_correspondences = 10;
+  // Standard deviation of a point-to-feature residual (m); scales J^T J into an information matrix.
+  double point_sigma_m = 0.05;
+  // Degenerate when eigenvalue < ratio * largest eigenvalue of its (translation or rotation) block.
+  double degeneracy_ratio = 0.02;
+  // Hold degenerate directions to the motion-model prior (false reproduces plain A-LOAM).
+  bool degeneracy_prior = true;
+  // Stiffness of that prior relative to the largest eigenvalue of its block: 1 pins the direction to the
+  // prior as firmly as the best-observed direction is pinned by the data (Zhang 2016's solution remapping
+  // in effect, but expressed as a residual so Ceres handles it).
+  double degeneracy_prior_strength = 1.0;
+  // Uncertainty of the motion model per sweep, used as the covariance of degenerate directions.
+  double prior_sigma_translation_m = 0.1;
+  double prior_sigma_rotation_rad = 0.01;
+};
+
+// Reads keys "<prefix>.max_solver_iterations", "<prefix>.loss", ... with the defaults above.
+RegistrationConfig registrationConfigFrom(const Config& c, const std::string& prefix);
+
+struct RegistrationResult {
+  bool ok = false;  // enough correspondences and a finite solution
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  Matrix6d information = Matrix6d::Zero();  // measurements only, lidar-frame tangent at `pose`
+  DegeneracyReport degeneracy;
+  int iterations = 0;
+  double final_cost = 0.0;
+  int num_correspondences = 0;
+};
+
+// Solves for the pose T (reference_T_sweep) starting at T0. `motion_prior` is the motion model's guess of T,
+// used only along degenerate directions.
+RegistrationResult registerStep(const Correspondences& matches, const Eigen::Isometry3d& T0,
+                                const Eigen::Isometry3d& motion_prior, const RegistrationConfig& config);
+
+}  // namespace adit

@@ -1,0 +1,156 @@
+#include "odometry/scan_to_scan.hpp"
+
+#include "odometry/feature_fit.hpp"
+#include "odometry/pose_increment.hpp"
+
+namespace adit {
+namespace {
+
+constexpr std::int32_t kSeedFlags =
+    PoseEstimate::kSeededByLinK3d | PoseEstimate::kSeededByImu | PoseEstimate::kSeededByMotionModel;
+
+// Covariance of a sweep whose registration failed: the motion model's uncertainty in every direction.
+Matrix6d priorCovariance(const RegistrationConfig& c) {
+  Matrix6d cov = Matrix6d::Zero();
+  cov.diagonal() << Eigen::Vector3d::Constant(c.prior_sigma_translation_m * c.prior_sigma_translation_m),
+      Eigen::Vector3d::Constant(c.prior_sigma_rotation_rad * c.prior_sigma_rotation_rad);
+  return cov;
+}
+
+}  // namespace
+
+ScanToScanConfig scanToScanConfigFrom(const Config& c) {
+  ScanToScanConfig s;
+  s.registration = registrationConfigFrom(c, "odometry");
+  s.outer_iterations = c.get<int>("odometry.outer_iterations", s.outer_iterations);
+  s.max_match_distance_m = c.get<double>("odometry.max_match_distance_m", s.max_match_distance_m);
+  s.ring_window = c.get<int>("odometry.ring_window", s.ring_window);
+  s.plane_neighbours = c.get<int>("odometry.plane_neighbours", s.plane_neighbours);
+  s.plane_max_point_distance_m = c.get<double>("odometry.plane_max_point_distance_m", s.plane_max_point_distance_m);
+  s.three_point_planes = c.get<bool>("odometry.three_point_planes", s.three_point_planes);
+  s.use_link3d_seed = c.get<bool>("odometry.use_link3d_seed", s.use_link3d_seed);
+  s.max_velocity_gap_s = c.get<double>("odometry.max_velocity_gap_s", s.max_velocity_gap_s);
+  return s;
+}
+
+ScanToScanOdometry::ScanToScanOdometry(ScanToScanConfig config) : config_(std::move(config)) {}
+
+void ScanToScanOdometry::reset() { *this = ScanToScanOdometry(config_); }
+
+Eigen::Isometry3d ScanToScanOdometry::predictMotion(std::int64_t utime) const {
+  const std::int64_t gap = utime - previous_utime_;
+  if (!has_previous_ || last_gap_us_ <= 0 || gap <= 0 || toSeconds(gap) > config_.max_velocity_gap_s)
+    return Eigen::Isometry3d::Identity();
+  return scaleMotion(last_motion_, static_cast<double>(gap) / static_cast<double>(last_gap_us_));
+}
+
+Correspondences ScanToScanOdometry::match(const FeatureSet& f, const Eigen::Isometry3d& T) const {
+  Correspondences m;
+  const double max_sq = config_.max_match_distance_m * config_.max_match_distance_m;
+  for (const LidarPoint& lp : f.corner_sharp) {
+    if (!lp.p.allFinite()) continue;
+    const Eigen::Vector3d p = lp.p.cast<double>(), q = T * p;
+    const int j = prev_corners_.nearest(q, max_sq);
+    if (j < 0) continue;
+    const int l = prev_corners_.nearestInNeighbourRings(prev_corners_.ring(j), config_.ring_window, q, max_sq);
+    if (l < 0) continue;
+    const Eigen::Vector3d dir = prev_corners_.point(l) - prev_corners_.point(j);
+    if (dir.norm() < 1e-3) continue;
+    m.lines.push_back({p, prev_corners_.point(j), dir.normalized()});
+  }
+  for (const LidarPoint& lp : f.surf_flat) {
+    if (!lp.p.allFinite()) continue;
+    const Eigen::Vector3d p = lp.p.cast<double>(), q = T * p;
+    // Preferred: a least-squares plane through several neighbours (robust to range noise, which tilts a
+    // three-point plane badly when its points are close together).
+    const auto near = prev_surfs_.nearestK(q, config_.plane_neighbours, max_sq);
+    std::vector<Eigen::Vector3d> pts;
+    bool several_rings = false;
+    for (int i : near) {
+      pts.push_back(prev_surfs_.point(i));
+      several_rings = several_rings || prev_surfs_.ring(i) != prev_surfs_.ring(near.front());
+    }
+    // Neighbours all on one ring are (nearly) collinear: the plane's tilt about that line would be noise.
+    if (several_rings && static_cast<int>(pts.size()) == config_.plane_neighbours) {
+      if (const auto plane = fitPlane(pts, config_.plane_max_point_distance_m)) {
+        m.planes.push_back({p, plane->normal, plane->offset});
+        continue;
+      }
+    }
+    // Fallback when the neighbours are collinear (one ring of a sparse sweep): A-LOAM's three points, the
+    // nearest, its nearest on the same ring and the nearest on a neighbouring ring.
+    const int j = near.empty() ? -1 : near.front();
+    if (j < 0 || !config_.three_point_planes) continue;
+    const int ring = prev_surfs_.ring(j);
+    const int l = prev_surfs_.nearestInRing(ring, q, max_sq, j);
+    const int k = prev_surfs_.nearestInNeighbourRings(ring, config_.ring_window, q, max_sq);
+    if (l < 0 || k < 0) continue;
+    const Eigen::Vector3d a = prev_surfs_.point(j), b = prev_surfs_.point(l), c = prev_surfs_.point(k);
+    const Eigen::Vector3d cross = (b - a).cross(c - a);
+    // Reject near-collinear triples: their normal is noise.
+    if (cross.norm() < 0.1 * (b - a).norm() * (c - a).norm() || cross.norm() < 1e-9) continue;
+    const Eigen::Vector3d n = cross.normalized();
+    m.planes.push_back({p, n, -n.dot(a)});
+  }
+  return m;
+}
+
+PoseEstimate ScanToScanOdometry::process(const FeatureSet& f, const std::optional<Eigen::Isometry3d>& prior,
+                                         int prior_flags) {
+  PoseEstimate out;
+  out.utime = f.utime;
+  const Eigen::Isometry3d motion_model = predictMotion(f.utime);
+  Eigen::Isometry3d seed = motion_model;
+  const bool prior_usable = prior && isFinitePose(*prior) &&
+                            (config_.use_link3d_seed || (prior_flags & PoseEstimate::kSeededByLinK3d) == 0);
+  if (prior_usable) {
+    seed = *prior;
+    out.flags |= prior_flags & kSeedFlags;
+  } else {
+    out.flags |= PoseEstimate::kSeededByMotionModel;
+  }
+  // Along degenerate directions hold to the motion model (IMU-aided if the prior came from the IMU), never
+  // to a LinK3D seed: that one is measured from the same, degenerate, geometry.
+  const bool imu_prior = prior_usable && (prior_flags & PoseEstimate::kSeededByImu) != 0;
+  const Eigen::Isometry3d hold = imu_prior ? *prior : motion_model;
+
+  Eigen::Isometry3d T = seed;
+  bool ok = has_previous_;
+  RegistrationResult r;
+  for (int round = 0; ok && round < std::max(1, config_.outer_iterations); ++round) {
+    r = registerStep(match(f, T), T, hold, config_.registration);
+    ok = r.ok;
+    out.iterations += r.iterations;
+    if (!ok) break;
+    const bool converged = hasConverged(T, r.pose);
+    T = r.pose;
+    if (converged) break;
+  }
+  if (ok) {
+    out.covariance = covarianceFrom(r.information, r.degeneracy, config_.registration.prior_sigma_translation_m,
+                                    config_.registration.prior_sigma_rotation_rad);
+    out.translation_eigenvalues = r.degeneracy.translation_eigenvalues;
+    out.rotation_eigenvalues = r.degeneracy.rotation_eigenvalues;
+    out.flags |= r.degeneracy.flags;
+    out.final_cost = r.final_cost;
+  } else {
+    T = seed;
+    out.covariance = priorCovariance(config_.registration);
+    // The very first sweep has nothing to register against: that is not a failure.
+    if (has_previous_) out.flags |= PoseEstimate::kRegistrationFailed;
+  }
+
+  if (has_previous_) {
+    last_motion_ = T;
+    last_gap_us_ = f.utime - previous_utime_;
+    pose_ = pose_ * T;
+  }
+  out.pose = pose_;
+  prev_corners_ = RingIndexedCloud(f.corner_less_sharp);
+  prev_surfs_ = RingIndexedCloud(f.surf_less_flat);
+  has_previous_ = true;
+  previous_utime_ = f.utime;
+  return out;
+}
+
+}  // namespace adit

@@ -1,0 +1,73 @@
+// Scan-to-scan lidar odometry (A-LOAM laserOdometry, with the known defects fixed): registers each sweep's
+// sharp edges and flat surfaces against the previous sweep's less-sharp / less-flat points, point-to-line and
+// point-to-plane in Ceres, correspondences recomputed every outer round, degeneracy measured from the
+// Jacobian and held to the motion model. Deterministic: the output depends only on the inputs and config.
+#pragma once
+
+#include "core/config.hpp"
+#include "core/types.hpp"
+#include "odometry/registration.hpp"
+#include "odometry/ring_cloud.hpp"
+
+#include <optional>
+
+namespace adit {
+
+struct ScanToScanConfig {
+  RegistrationConfig registration;  // keys "odometry.<field>" (see registration.hpp)
+  // Correspondence rounds; correspondences are recomputed at the new pose each round. A-LOAM uses 2.
+  int outer_iterations = 3;
+  // Largest point-to-neighbour distance accepted when matching (m). Generous because the first sweeps of a
+  // run have no velocity estimate yet (KITTI moves up to 1.5 m per sweep); A-LOAM uses 5 m.
+  double max_match_distance_m = 3.0;
+  // Rings either side searched for the second line point / third plane point (A-LOAM: 2.5 -> 2).
+  int ring_window = 2;
+  // Planes are fitted to this many nearest previous less-flat points (least squares, rejected if any is
+  // farther than plane_max_point_distance_m from the plane, A-LOAM mapping's 0.2 m); when they are collinear
+  // the A-LOAM three-point plane is used instead.
+  int plane_neighbours = 5;
+  double plane_max_point_distance_m = 0.2;
+  bool three_point_planes = true;
+  // Accept a prior flagged kSeededByLinK3d as initial guess (false = A-LOAM ablation: motion model only).
+  bool use_link3d_seed = true;
+  // Longest gap between sweeps (s) over which the constant-velocity model extrapolates; beyond, no motion.
+  double max_velocity_gap_s = 0.5;
+};
+
+// Reads "odometry.*" keys with the defaults above.
+ScanToScanConfig scanToScanConfigFrom(const Config& c);
+
+class ScanToScanOdometry {
+ public:
+  explicit ScanToScanOdometry(ScanToScanConfig config = {});
+
+  // Registers the sweep against the previous one and returns T_odom_lidar at f.utime. prior_T_prev_curr is
+  // an optional initial guess (LinK3D RANSAC, IMU rotation) whose origin is given by prior_flags
+  // (PoseEstimate::kSeededByLinK3d / kSeededByImu / kSeededByMotionModel); without it, constant velocity.
+  // Never throws: a sweep that cannot be registered keeps the prior motion and is flagged
+  // kRegistrationFailed.
+  PoseEstimate process(const FeatureSet& f, const std::optional<Eigen::Isometry3d>& prior_T_prev_curr = std::nullopt,
+                       int prior_flags = 0);
+
+  // Constant-velocity guess of T_prev_curr for a sweep at `utime` (identity before two sweeps were seen).
+  Eigen::Isometry3d predictMotion(std::int64_t utime) const;
+
+  // The correspondences of f's sharp / flat points against the previous sweep at a guess of T_prev_curr
+  // (what one registration round uses; public for diagnostics and tests).
+  Correspondences match(const FeatureSet& f, const Eigen::Isometry3d& T_prev_curr) const;
+
+  const Eigen::Isometry3d& pose() const { return pose_; }
+  void reset();
+
+ private:
+  ScanToScanConfig config_;
+  RingIndexedCloud prev_corners_;  // previous corner_less_sharp, previous lidar frame
+  RingIndexedCloud prev_surfs_;    // previous surf_less_flat
+  bool has_previous_ = false;
+  std::int64_t previous_utime_ = 0;
+  Eigen::Isometry3d pose_ = Eigen::Isometry3d::Identity();        // T_odom_lidar of the previous sweep
+  Eigen::Isometry3d last_motion_ = Eigen::Isometry3d::Identity();  // T_prev_curr of the previous step
+  std::int64_t last_gap_us_ = 0;                                   // 0: no velocity estimate yet
+};
+
+}  // namespace adit

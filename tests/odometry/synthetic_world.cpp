@@ -1,0 +1,129 @@
+#include "synthetic_world.hpp"
+
+#include <cmath>
+#include <limits>
+#include <random>
+
+namespace adit::test {
+namespace {
+
+// Ray/box distance: exit distance for a box we are inside, entry distance for a solid one; inf if missed.
+double hitDistance(const Box& b, const Eigen::Vector3d& o, const Eigen::Vector3d& d) {
+  double t_near = -std::numeric_limits<double>::infinity(), t_far = std::numeric_limits<double>::infinity();
+  for (int i = 0; i < 3; ++i) {
+    if (std::abs(d[i]) < 1e-12) {
+      if (o[i] < b.min[i] || o[i] > b.max[i]) return std::numeric_limits<double>::infinity();
+      continue;
+    }
+    double t0 = (b.min[i] - o[i]) / d[i], t1 = (b.max[i] - o[i]) / d[i];
+    if (t0 > t1) std::swap(t0, t1);
+    t_near = std::max(t_near, t0);
+    t_far = std::min(t_far, t1);
+  }
+  if (t_near > t_far) return std::numeric_limits<double>::infinity();
+  if (b.inside) return t_far > 0 ? t_far : std::numeric_limits<double>::infinity();
+  return t_near > 1e-6 ? t_near : std::numeric_limits<double>::infinity();
+}
+
+// A hit near two faces of its box lies on an edge of that box.
+bool onEdge(const Box& b, const Eigen::Vector3d& p, double band) {
+  int near_faces = 0;
+  for (int i = 0; i < 3; ++i)
+    if (std::abs(p[i] - b.min[i]) < band || std::abs(p[i] - b.max[i]) < band) ++near_faces;
+  return near_faces >= 2;
+}
+
+bool nearRange(const Box& b, const Eigen::Vector3d& o, double range) {
+  const Eigen::Vector3d closest = o.cwiseMax(b.min).cwiseMin(b.max);
+  return b.inside || (closest - o).norm() < range;
+}
+
+}  // namespace
+
+Eigen::Isometry3d poseFrom(double x, double y, double z, double roll, double pitch, double yaw) {
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = (Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()) *
+                Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitX()))
+                   .toRotationMatrix();
+  T.translation() = Eigen::Vector3d(x, y, z);
+  return T;
+}
+
+World boxRoom() {
+  World w;
+  w.boxes.push_back({{-12, -8, -1.5}, {14, 7, 4.0}, true});
+  w.boxes.push_back({{3, 2, -1.5}, {4, 3, 4.0}, false});      // pillars
+  w.boxes.push_back({{-6, -4, -1.5}, {-5, -3, 4.0}, false});
+  w.boxes.push_back({{8, -5, -1.5}, {8.6, -4.4, 4.0}, false});
+  w.boxes.push_back({{-3, 4, -1.5}, {-1, 5.5, 0.5}, false});  // crates
+  w.boxes.push_back({{5, -3, -1.5}, {6.5, -2, -0.2}, false});
+  return w;
+}
+
+World featurelessCorridor() {
+  World w;
+  w.boxes.push_back({{-1000, -2, -1.2}, {1000, 2, 2.3}, true});
+  return w;
+}
+
+World roadwayWithPillars(double length, double spacing) {
+  World w;
+  w.boxes.push_back({{-50, -2.5, -1.2}, {length + 50, 2.5, 2.5}, true});
+  int k = 0;
+  for (double x = -40; x < length + 40; x += spacing, ++k) {
+    const double y0 = (k % 2 == 0) ? -2.5 : 2.1;  // 0.4 m deep pillars on alternating walls
+    w.boxes.push_back({{x, y0, -1.2}, {x + 0.5, y0 + 0.4, 2.5}, false});
+  }
+  return w;
+}
+
+FeatureSet simulateSweep(const World& world, const Eigen::Isometry3d& T, const LidarModel& lidar, std::int64_t utime,
+                         std::uint32_t seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> noise(0.0, lidar.range_noise);
+  const Eigen::Vector3d origin = T.translation();
+  std::vector<const Box*> visible;
+  for (const Box& b : world.boxes)
+    if (nearRange(b, origin, lidar.max_range)) visible.push_back(&b);
+
+  FeatureSet f;
+  f.utime = utime;
+  f.cloud.utime = utime;
+  f.cloud.num_beams = lidar.beams;
+  f.cloud.has_ring = true;
+  f.cloud.deskewed = true;
+  const double deg = M_PI / 180.0;
+  for (int ring = 0; ring < lidar.beams; ++ring) {
+    const double el = (lidar.min_elevation_deg + (lidar.max_elevation_deg - lidar.min_elevation_deg) * ring /
+                                                     std::max(1, lidar.beams - 1)) * deg;
+    int surf_count = 0, corner_count = 0;
+    for (int a = 0; a < lidar.azimuth_steps; ++a) {
+      const double az = 2.0 * M_PI * a / lidar.azimuth_steps;
+      const Eigen::Vector3d dir_l(std::cos(el) * std::cos(az), std::cos(el) * std::sin(az), std::sin(el));
+      const Eigen::Vector3d dir_w = T.linear() * dir_l;
+      double best = std::numeric_limits<double>::infinity();
+      const Box* hit = nullptr;
+      for (const Box* b : visible) {
+        const double t = hitDistance(*b, origin, dir_w);
+        if (t < best) best = t, hit = b;
+      }
+      if (!hit || best > lidar.max_range) continue;
+      const bool edge = onEdge(*hit, origin + best * dir_w, lidar.edge_band);
+      LidarPoint p;
+      p.p = ((best + noise(rng)) * dir_l).cast<float>();
+      p.ring = static_cast<std::uint16_t>(ring);
+      f.cloud.points.push_back(p);
+      if (edge) {
+        f.corner_less_sharp.push_back(p);
+        if (corner_count++ % 5 == 0) f.corner_sharp.push_back(p);
+      } else {
+        if (surf_count % 4 == 0) f.surf_less_flat.push_back(p);
+        if (surf_count % 48 == 0) f.surf_flat.push_back(p);
+        ++surf_count;
+      }
+    }
+  }
+  return f;
+}
+
+}  // namespace adit::test

@@ -1,0 +1,170 @@
+// Scan-to-scan and scan-to-map registration recover known rigid transforms between synthetic sweeps, and
+// survive empty or corrupt input.
+#include "core/geometry.hpp"
+#include "mapping/scan_to_map.hpp"
+#include "odometry/scan_to_scan.hpp"
+#include "synthetic_world.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <limits>
+
+namespace adit {
+namespace {
+
+constexpr double kDeg = M_PI / 180.0;
+
+double rotationErrorDeg(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b) {
+  return rotationAngle(a.inverse() * b) / kDeg;
+}
+double translationError(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b) {
+  return (a.inverse() * b).translation().norm();
+}
+
+// Moves every point of a FeatureSet by T (for "transformed copy" tests).
+FeatureSet transformedCopy(const FeatureSet& f, const Eigen::Isometry3d& T, std::int64_t utime) {
+  FeatureSet g = f;
+  g.utime = utime;
+  const Eigen::Isometry3f Tf = T.cast<float>();
+  for (auto* set : {&g.cloud.points, &g.corner_sharp, &g.corner_less_sharp, &g.surf_flat, &g.surf_less_flat})
+    for (LidarPoint& p : *set) p.p = Tf * p.p;
+  return g;
+}
+
+const Eigen::Isometry3d kStart = test::poseFrom(0.5, -0.3, 0.2, 0.0, 0.0, 0.3);
+const Eigen::Isometry3d kMotion = test::poseFrom(0.4, -0.2, 0.05, 1.0 * kDeg, -0.5 * kDeg, 3.0 * kDeg);
+
+TEST(ScanToScan, RecoversTransformOfExactCopy) {
+  const auto world = test::boxRoom();
+  const FeatureSet a = test::simulateSweep(world, kStart, {}, 0, 1);
+  // Points seen from the moved sensor: p_curr = T_prev_curr^-1 * p_prev.
+  const FeatureSet b = transformedCopy(a, kMotion.inverse(), 100000);
+  ScanToScanOdometry odom;
+  odom.process(a);
+  const PoseEstimate e = odom.process(b);
+  EXPECT_EQ(e.flags & PoseEstimate::kRegistrationFailed, 0);
+  // Not exactly zero: planes are least-squares fits to 5 noisy neighbours, not the matched point itself.
+  EXPECT_LT(translationError(e.pose, kMotion), 2e-3);
+  EXPECT_LT(rotationErrorDeg(e.pose, kMotion), 0.01);
+}
+
+TEST(ScanToScan, RecoversTransformBetweenIndependentSweeps) {
+  const auto world = test::boxRoom();
+  ScanToScanOdometry odom;
+  odom.process(test::simulateSweep(world, kStart, {}, 0, 1));
+  const PoseEstimate e = odom.process(test::simulateSweep(world, kStart * kMotion, {}, 100000, 2));
+  EXPECT_EQ(e.flags & PoseEstimate::kRegistrationFailed, 0);
+  EXPECT_EQ(e.flags & (PoseEstimate::kDegenerateTranslation | PoseEstimate::kDegenerateRotation), 0);
+  EXPECT_LT(translationError(e.pose, kMotion), 0.02);
+  EXPECT_LT(rotationErrorDeg(e.pose, kMotion), 0.2);
+  // Well-conditioned: covariance small and positive definite.
+  EXPECT_GT(e.covariance.diagonal().minCoeff(), 0.0);
+  const double max_translation_variance = e.covariance.topLeftCorner<3, 3>().diagonal().maxCoeff();
+  EXPECT_LT(max_translation_variance, 1e-3);
+  EXPECT_GT(e.translation_eigenvalues[0], 0.0);
+}
+
+TEST(ScanToScan, UsesSeedForLargeMotion) {
+  // 2.5 m and 10 degrees between sweeps: a near-correct seed (e.g. LinK3D) makes it converge.
+  const auto world = test::boxRoom();
+  const Eigen::Isometry3d big = test::poseFrom(2.5, 0.6, 0.0, 0.0, 0.0, 10.0 * kDeg);
+  ScanToScanOdometry odom;
+  odom.process(test::simulateSweep(world, kStart, {}, 0, 1));
+  const Eigen::Isometry3d seed = big * test::poseFrom(0.15, -0.1, 0.0, 0.0, 0.0, 1.0 * kDeg);
+  const PoseEstimate e =
+      odom.process(test::simulateSweep(world, kStart * big, {}, 100000, 2), seed, PoseEstimate::kSeededByLinK3d);
+  EXPECT_TRUE(e.flags & PoseEstimate::kSeededByLinK3d);
+  // Independent sweeps of a 16-beam lidar: ~1 cm / ~0.1 deg is the floor set by features near wall-floor
+  // junctions, whose neighbours straddle two faces (measured 0.8 cm, 0.13 deg).
+  EXPECT_LT(translationError(e.pose, big), 0.02);
+  EXPECT_LT(rotationErrorDeg(e.pose, big), 0.2);
+}
+
+TEST(ScanToScan, ConstantVelocityTracksASequence) {
+  const auto world = test::boxRoom();
+  ScanToScanOdometry odom;
+  const Eigen::Isometry3d step = test::poseFrom(0.3, 0.05, 0.0, 0.0, 0.0, 1.5 * kDeg);
+  Eigen::Isometry3d truth = kStart;
+  for (int i = 0; i < 8; ++i) {
+    const PoseEstimate e = odom.process(test::simulateSweep(world, truth, {}, i * 100000, 10 + i));
+    EXPECT_EQ(e.flags & PoseEstimate::kRegistrationFailed, 0) << "sweep " << i;
+    EXPECT_TRUE(e.flags & PoseEstimate::kSeededByMotionModel);
+    truth = truth * step;
+  }
+  const Eigen::Isometry3d truth_end = kStart.inverse() * (truth * step.inverse());
+  // Seven registrations (measured 0.29 deg accumulated).
+  EXPECT_LT(translationError(odom.pose(), truth_end), 0.05);
+  EXPECT_LT(rotationErrorDeg(odom.pose(), truth_end), 0.5);
+}
+
+TEST(ScanToScan, EmptyAndCorruptSweepsAreFlaggedNotFatal) {
+  const auto world = test::boxRoom();
+  ScanToScanOdometry odom;
+  odom.process(test::simulateSweep(world, kStart, {}, 0, 1));
+  FeatureSet empty;
+  empty.utime = 100000;
+  const Eigen::Isometry3d prior = test::poseFrom(0.1, 0, 0, 0, 0, 0);
+  const PoseEstimate e = odom.process(empty, prior, PoseEstimate::kSeededByImu);
+  EXPECT_TRUE(e.flags & PoseEstimate::kRegistrationFailed);
+  EXPECT_LT(translationError(e.pose, prior), 1e-12);  // kept the prior
+  EXPECT_TRUE(e.covariance.allFinite());
+
+  FeatureSet nan = test::simulateSweep(world, kStart, {}, 200000, 2);
+  for (LidarPoint& p : nan.surf_flat) p.p.x() = std::numeric_limits<float>::quiet_NaN();
+  for (LidarPoint& p : nan.corner_less_sharp) p.p.y() = std::numeric_limits<float>::infinity();
+  const PoseEstimate n = odom.process(nan);
+  EXPECT_TRUE(n.pose.matrix().allFinite());
+  EXPECT_TRUE(n.covariance.allFinite());
+  const PoseEstimate nonfinite_prior =
+      odom.process(test::simulateSweep(world, kStart, {}, 300000, 3),
+                   Eigen::Isometry3d(Eigen::Translation3d(std::nan(""), 0, 0)), PoseEstimate::kSeededByLinK3d);
+  EXPECT_TRUE(nonfinite_prior.pose.matrix().allFinite());
+}
+
+TEST(ScanToScan, IsDeterministic) {
+  const auto world = test::boxRoom();
+  const auto run = [&] {
+    ScanToScanOdometry odom;
+    Eigen::Isometry3d truth = kStart;
+    PoseEstimate last;
+    for (int i = 0; i < 4; ++i, truth = truth * kMotion) last = odom.process(test::simulateSweep(world, truth, {}, i * 100000, 5 + i));
+    return last;
+  };
+  const PoseEstimate a = run(), b = run();
+  EXPECT_EQ(0, std::memcmp(a.pose.data(), b.pose.data(), sizeof(double) * 16));
+  EXPECT_EQ(0, std::memcmp(a.covariance.data(), b.covariance.data(), sizeof(double) * 36));
+}
+
+TEST(ScanToMap, RefinesAPoorOdometryGuessAgainstTheMap) {
+  const auto world = test::boxRoom();
+  ScanToMapMapper mapper;
+  PoseEstimate odom;
+  odom.pose = kStart;
+  mapper.process(test::simulateSweep(world, kStart, {}, 0, 1), odom);
+  // Odometry claims the robot did not move; it moved by kMotion.
+  odom.utime = 100000;
+  const PoseEstimate e = mapper.process(test::simulateSweep(world, kStart * kMotion, {}, 100000, 2), odom);
+  EXPECT_EQ(e.flags & PoseEstimate::kRegistrationFailed, 0);
+  EXPECT_LT(translationError(e.pose, kStart * kMotion), 0.02);
+  EXPECT_LT(rotationErrorDeg(e.pose, kStart * kMotion), 0.1);
+  EXPECT_GT(mapper.surfMap().numPoints(), 1000u);
+  EXPECT_GT(mapper.cornerMap().numPoints(), 50u);
+}
+
+TEST(ScanToMap, EmptySweepKeepsThePrediction) {
+  const auto world = test::boxRoom();
+  ScanToMapMapper mapper;
+  PoseEstimate odom;
+  odom.pose = kStart;
+  mapper.process(test::simulateSweep(world, kStart, {}, 0, 1), odom);
+  FeatureSet empty;
+  odom.pose = kStart * kMotion;
+  const PoseEstimate e = mapper.process(empty, odom);
+  EXPECT_TRUE(e.flags & PoseEstimate::kRegistrationFailed);
+  EXPECT_LT(translationError(e.pose, kStart * kMotion), 1e-9);
+}
+
+}  // namespace
+}  // namespace adit
