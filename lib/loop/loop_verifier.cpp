@@ -16,8 +16,10 @@ std::vector<Eigen::Vector3f> buildSubmap(const std::vector<SubmapPiece>& pieces,
 
 namespace {
 
+// A tight fit, converged or not: an alignment still sliding along an unconstrained direction fits tightly too,
+// and is reported as degenerate rather than as a poor fit.
 bool fits(const IcpResult& r, const LoopVerifierConfig& config) {
-  return r.converged && r.rms <= config.max_rms && r.inlier_ratio >= config.min_inlier_ratio;
+  return r.rms <= config.max_rms && r.inlier_ratio >= config.min_inlier_ratio;
 }
 
 }  // namespace
@@ -42,8 +44,10 @@ LoopVerification verifyLoop(const std::vector<Eigen::Vector3f>& query_cloud,
     if (fits(r, config)) break;
   }
   if (!fits(out.icp, config)) return out;
-  out.verdict = out.icp.eigenvalue_ratio >= config.min_eigenvalue_ratio ? LoopVerdict::kAccepted
-                                                                         : LoopVerdict::kDegenerate;
+  if (out.icp.eigenvalue_ratio < config.min_eigenvalue_ratio)
+    out.verdict = LoopVerdict::kDegenerate;
+  else if (out.icp.converged)
+    out.verdict = LoopVerdict::kAccepted;
   return out;
 }
 

@@ -13,9 +13,11 @@ namespace adit {
 struct PoseGraphConfig {
   // Ceres Levenberg-Marquardt iterations per optimize(); a warm-started graph converges in a handful.
   int max_iterations = 50;
-  // Cauchy loss scale on loop edges, in whitened units (standard deviations): a loop residual of a few sigma
-  // keeps nearly full weight, a gross outlier's pull saturates.
-  double loop_loss_scale = 3.0;
+  // Cauchy loss scale on loop edges, in whitened units (loop standard deviations). Accepted loops already passed
+  // verification and both gates, and a valid loop removing metres of drift starts 10-20 sigma (of its own
+  // few-cm noise) away, so a small scale would silence exactly the loops we want; 10 keeps those near their
+  // quadratic region while a gross false loop (20 m off = ~400 sigma) pulls with ~1/40 of its weight.
+  double loop_loss_scale = 10.0;
 };
 
 struct PoseGraphEdge {

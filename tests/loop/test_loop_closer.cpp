@@ -1,0 +1,220 @@
+// The loop-closer stage on simulated 16-beam sweeps: a drifting lap of a roadway block (true loops closed,
+// ATE halved), a periodic roadway (aliasing rejected), and the degeneracy check of the verifier.
+#include "box_world.hpp"
+#include "loop/loop_closer.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <random>
+
+using namespace adit;
+using adit::testing::BoxWorld;
+using adit::testing::poseXYYaw;
+using adit::testing::simulateSweep;
+
+namespace {
+
+constexpr double kDeg = M_PI / 180.0;
+
+// A 5 m roadway around a 30 x 30 m block of rock (centre line: a 35 m square), with equipment on the walls.
+BoxWorld blockLoop() {
+  BoxWorld w;
+  w.addFloorAndRoof(-10, -10, 50, 50, 4.0);
+  w.add(5, 5, 0, 35, 35, 4);       // the block
+  w.add(-3, -3, 0, 43, 0, 4);      // outer walls
+  w.add(-3, 40, 0, 43, 43, 4);
+  w.add(-3, -3, 0, 0, 43, 4);
+  w.add(40, -3, 0, 43, 43, 4);
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  for (int i = 0; i < 40; ++i) {  // boxes against the walls, on all four sides
+    const double s = 2 + 36 * u(rng), len = 0.6 + 2 * u(rng), d = 0.3 + 0.8 * u(rng), z = 0.8 + 2.7 * u(rng);
+    switch (i % 8) {
+      case 0: w.add(s, 0, 0, s + len, d, z); break;
+      case 1: w.add(s, 5 - d, 0, s + len, 5, z); break;
+      case 2: w.add(40 - d, s, 0, 40, s + len, z); break;
+      case 3: w.add(35, s, 0, 35 + d, s + len, z); break;
+      case 4: w.add(s, 40 - d, 0, s + len, 40, z); break;
+      case 5: w.add(s, 35, 0, s + len, 35 + d, z); break;
+      case 6: w.add(0, s, 0, d, s + len, z); break;
+      default: w.add(5 - d, s, 0, 5, s + len, z); break;
+    }
+  }
+  return w;
+}
+
+// True poses every 1 m along the block's centre line, `laps` times plus `extra` metres.
+std::vector<Eigen::Isometry3d> lapPoses(int metres) {
+  std::vector<Eigen::Isometry3d> out;
+  double x = 2.5, y = 2.5, yaw = 0.0;
+  for (int k = 0; k < metres; ++k) {
+    out.push_back(poseXYYaw(x, y, 1.8, yaw));
+    const double nx = x + std::cos(yaw), ny = y + std::sin(yaw);
+    if (nx > 37.6 || nx < 2.4 || ny > 37.6 || ny < 2.4) yaw += M_PI / 2;  // corner: turn left
+    x += std::round(std::cos(yaw)) * 1.0;
+    y += std::round(std::sin(yaw)) * 1.0;
+  }
+  return out;
+}
+
+// Mapper poses: the true steps with a heading drift per metre.
+std::vector<Eigen::Isometry3d> drifted(const std::vector<Eigen::Isometry3d>& truth, double yaw_drift_per_step) {
+  std::vector<Eigen::Isometry3d> out{truth[0]};
+  for (std::size_t k = 1; k < truth.size(); ++k) {
+    Eigen::Isometry3d step = truth[k - 1].inverse() * truth[k];
+    step.linear() = step.linear() * Eigen::AngleAxisd(yaw_drift_per_step, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    out.push_back(out.back() * step);
+  }
+  return out;
+}
+
+double ate(const std::vector<Eigen::Isometry3d>& estimate, const std::vector<Eigen::Isometry3d>& truth) {
+  double sum = 0;
+  for (std::size_t k = 0; k < truth.size(); ++k) sum += (estimate[k].translation() - truth[k].translation()).squaredNorm();
+  return std::sqrt(sum / static_cast<double>(truth.size()));
+}
+
+LoopCloserConfig testConfig() {
+  LoopCloserConfig c;
+  c.keyframe_distance = 0.9;  // the simulated sweeps are exactly 1 m apart: one keyframe each
+  return c;
+}
+
+struct Drive {
+  LoopCloser closer{testConfig()};
+  int false_loops = 0;
+};
+
+void drive(Drive& run, const BoxWorld& world, const std::vector<Eigen::Isometry3d>& truth,
+           const std::vector<Eigen::Isometry3d>& mapped) {
+  for (std::size_t k = 0; k < truth.size(); ++k) {
+    PoseEstimate pe;
+    pe.utime = static_cast<std::int64_t>(k) * 1000000;  // 1 m/s, one sweep per keyframe
+    pe.pose = mapped[k];
+    LidarScan scan = simulateSweep(world, truth[k], static_cast<std::uint32_t>(k + 1), 450);
+    scan.utime = pe.utime;
+    const LoopCloser::Result r = run.closer.process(pe, scan);
+    for (const LoopConstraint& loop : r.loops) {
+      const Eigen::Isometry3d T_true = truth[static_cast<std::size_t>(loop.match_index)].inverse() *
+                                       truth[static_cast<std::size_t>(loop.query_index)];
+      const double err = (T_true.inverse() * loop.T_match_query).translation().norm();
+      std::printf("loop %d -> %d: sc %.3f, rms %.3f m, inliers %.2f, error vs truth %.3f m\n", loop.query_index,
+                  loop.match_index, loop.scan_context_distance, loop.fitness, loop.inlier_ratio, err);
+      if (err > 0.5) ++run.false_loops;
+    }
+  }
+}
+
+void printStats(const LoopCloserStats& s) {
+  std::printf("keyframes %d queries %d candidates %d | rejected: fitness %d degenerate %d odometry %d pairwise %d | "
+              "pending %d accepted %d\n",
+              s.keyframes, s.queries, s.candidates, s.rejected_fitness, s.rejected_degenerate, s.rejected_odometry,
+              s.rejected_pairwise, s.pending, s.accepted);
+}
+
+}  // namespace
+
+TEST(LoopCloser, ClosesADriftingLapAndHalvesTheError) {
+  const BoxWorld world = blockLoop();
+  const auto truth = lapPoses(140 + 25);
+  const auto mapped = drifted(truth, 0.02 * kDeg);
+  Drive run;
+  drive(run, world, truth, mapped);
+  printStats(run.closer.stats());
+  std::vector<Eigen::Isometry3d> corrected;
+  Trajectory uncorrected;
+  for (std::size_t k = 0; k < truth.size(); ++k) uncorrected.push_back({static_cast<std::int64_t>(k) * 1000000, mapped[k]});
+  for (const StampedPose& p : run.closer.correctedTrajectory(uncorrected)) corrected.push_back(p.pose);
+  const double before = ate(mapped, truth), after = ate(corrected, truth);
+  std::printf("ATE %.3f m without loop closure, %.3f m with\n", before, after);
+  EXPECT_GE(run.closer.stats().accepted, 1);
+  EXPECT_EQ(run.false_loops, 0);
+  EXPECT_LE(after, 0.5 * before);
+  EXPECT_EQ(static_cast<int>(run.closer.keyframes().size()), static_cast<int>(truth.size()));
+  EXPECT_GT(run.closer.correctedMap(0.5).size(), 1000u);
+}
+
+TEST(LoopCloser, RejectsAPeriodicRoadway) {
+  // A straight roadway whose equipment repeats exactly every 60 m: a place 60 m back looks identical.
+  BoxWorld world;
+  world.addFloorAndRoof(-200, -10, 300, 10, 4.0);
+  world.add(-200, 2.4, 0, 300, 4.4, 4);
+  world.add(-200, -4.4, 0, 300, -2.4, 4);
+  std::mt19937 rng(9);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  std::vector<std::array<double, 4>> pattern;
+  for (int i = 0; i < 16; ++i) pattern.push_back({60 * u(rng), 0.6 + 2 * u(rng), 0.4 + 0.8 * u(rng), 0.8 + 2.7 * u(rng)});
+  for (int period = -3; period < 5; ++period)
+    for (std::size_t i = 0; i < pattern.size(); ++i) {
+      const auto& [x, len, d, z] = pattern[i];
+      const double x0 = x + 60.0 * period;
+      if (i % 2 == 0) world.add(x0, 2.4 - d, 0, x0 + len, 2.4, z);
+      else world.add(x0, -2.4, 0, x0 + len, -2.4 + d, z);
+    }
+  std::vector<Eigen::Isometry3d> truth;
+  for (int k = 0; k < 130; ++k) truth.push_back(poseXYYaw(k, 0.1 * std::sin(0.3 * k), 1.8, 0.0));
+  Drive run;
+  drive(run, world, truth, drifted(truth, 0.01 * kDeg));
+  printStats(run.closer.stats());
+  EXPECT_EQ(run.closer.stats().accepted, 0);
+  EXPECT_EQ(run.false_loops, 0);
+  // The aliased places were proposed and fitted, and the odometry gate is what stopped them.
+  EXPECT_GT(run.closer.stats().rejected_odometry, 0);
+}
+
+TEST(LoopVerifier, FeaturelessRoadwayIsDegenerateAndEquipmentMakesItObservable) {
+  const auto verify = [](const BoxWorld& world) {
+    std::vector<SubmapPiece> pieces;
+    std::vector<LidarScan> scans;
+    for (int j = -5; j <= 5; ++j) scans.push_back(simulateSweep(world, poseXYYaw(j, 0, 1.8, 0), 100 + j));
+    std::vector<std::vector<Eigen::Vector3f>> clouds;
+    for (const auto& s : scans) clouds.push_back(adit::testing::positions(s));
+    for (int j = -5; j <= 5; ++j) pieces.push_back({&clouds[static_cast<std::size_t>(j + 5)], poseXYYaw(j, 0, 0, 0)});
+    const LoopVerifierConfig config;
+    const auto submap = buildSubmap(pieces, config.submap_voxel);
+    const auto query = adit::testing::positions(simulateSweep(world, poseXYYaw(0.3, 0.2, 1.8, 0.05), 7));
+    // Seed 0.5 m and 3 deg off.
+    const LoopVerification v = verifyLoop(query, submap, {poseXYYaw(-0.2, 0.1, 0, 0.1)}, config);
+    std::printf("%s: rms %.3f inliers %.2f eigenvalue ratio %.4f, x error %.3f m\n", toString(v.verdict), v.icp.rms,
+                v.icp.inlier_ratio, v.icp.eigenvalue_ratio, v.T_match_query.translation().x() - 0.3);
+    return v;
+  };
+  BoxWorld plain;
+  plain.addFloorAndRoof(-100, -10, 100, 10, 4.0);
+  plain.add(-100, 2.4, 0, 100, 4.4, 4);
+  plain.add(-100, -4.4, 0, 100, -2.4, 4);
+  EXPECT_EQ(verify(plain).verdict, LoopVerdict::kDegenerate);
+  const LoopVerification good = verify(adit::testing::makeRoadway(3, 4.8, 12, true, -100, 100));
+  EXPECT_EQ(good.verdict, LoopVerdict::kAccepted);
+  EXPECT_NEAR(good.T_match_query.translation().x(), 0.3, 0.05);
+  EXPECT_NEAR(good.T_match_query.translation().y(), 0.2, 0.05);
+}
+
+TEST(LoopCloser, BadInputNeverCrashes) {
+  LoopCloser closer;
+  PoseEstimate pe;
+  LidarScan empty;
+  EXPECT_TRUE(closer.process(pe, empty).keyframe_added);  // first keyframe, even without points
+  pe.utime = 1;
+  pe.pose.translation().x() = std::nan("");
+  EXPECT_FALSE(closer.process(pe, empty).keyframe_added);
+  pe.utime = 0;  // out of order
+  pe.pose = Eigen::Isometry3d::Identity();
+  pe.pose.translation().x() = 5;
+  EXPECT_FALSE(closer.process(pe, empty).keyframe_added);
+  EXPECT_EQ(closer.stats().invalid_sweeps, 2);
+}
+
+TEST(LoopCloser, ConfigReadsDottedKeys) {
+  Config c;
+  c.set("loop.scan_context.rings", "30");
+  c.set("loop.verifier.max_rms", "0.1");
+  c.set("loop.min_consistent_loops", "1");
+  const LoopCloserConfig k = loopCloserConfigFrom(c);
+  EXPECT_EQ(k.scan_context.rings, 30);
+  EXPECT_DOUBLE_EQ(k.verifier.max_rms, 0.1);
+  EXPECT_EQ(k.min_consistent_loops, 1);
+  EXPECT_DOUBLE_EQ(k.keyframe_distance, 1.0);
+}
