@@ -14,12 +14,33 @@ EvalConfig evalConfigFrom(const adit::Config& c) {
   return d;
 }
 
+namespace {
+
+bool finite(const StampedPose& p) { return p.pose.matrix().allFinite(); }
+
+// Pairs with a NaN/inf pose would poison the alignment and every statistic: drop and count them.
+std::size_t dropNonFinite(AssociatedTrajectories& m) {
+  Trajectory gt, est;
+  for (std::size_t k = 0; k < m.gt.size(); ++k) {
+    if (!finite(m.gt[k]) || !finite(m.est[k])) continue;
+    gt.push_back(m.gt[k]);
+    est.push_back(m.est[k]);
+  }
+  const std::size_t dropped = m.gt.size() - gt.size();
+  m.gt = std::move(gt);
+  m.est = std::move(est);
+  return dropped;
+}
+
+}  // namespace
+
 EvalResult evaluate(const Trajectory& gt, const Trajectory& est, const EvalConfig& config) {
   EvalResult r;
   r.align = config.align;
   r.gt_poses = gt.size();
   r.est_poses = est.size();
-  const AssociatedTrajectories matched = associate(gt, est, toUtime(config.max_time_diff_s));
+  AssociatedTrajectories matched = associate(gt, est, toUtime(config.max_time_diff_s));
+  r.non_finite_dropped = dropNonFinite(matched);
   r.matched_poses = matched.gt.size();
   if (r.matched_poses == 0) {
     r.message = "no matching timestamps between ground truth (" + std::to_string(gt.size()) + " poses) and estimate (" +
@@ -29,8 +50,11 @@ EvalResult evaluate(const Trajectory& gt, const Trajectory& est, const EvalConfi
   r.valid = true;
   r.gt = matched.gt;
   r.alignment = solveAlignment(matched.gt, matched.est, config.align);
+  if (r.non_finite_dropped > 0)
+    r.message = std::to_string(r.non_finite_dropped) + " matched pairs with non-finite poses ignored";
   if (r.alignment.degenerate)
-    r.message = "alignment degenerate (points on a line or too few): only the centroids were matched";
+    r.message += std::string(r.message.empty() ? "" : "; ") +
+                 "alignment degenerate (points on a line or too few): only the centroids were matched";
   r.est_aligned = applyAlignment(matched.est, r.alignment);
 
   r.ape_errors_m = apeTranslation(r.gt, r.est_aligned);

@@ -48,6 +48,7 @@ struct EvalResult {
   bool valid = false;      // false: nothing to evaluate (see message)
   std::string message;     // why not valid, or a warning (e.g. degenerate alignment)
   std::size_t gt_poses = 0, est_poses = 0, matched_poses = 0;
+  std::size_t non_finite_dropped = 0;  // matched pairs ignored because a pose had NaN/inf
   AlignMode align = AlignMode::kSE3;
   Similarity alignment;
   ErrorStats ape_m;

@@ -106,8 +106,8 @@ std::string formatReport(const EvalResult& r) {
 std::string toJson(const EvalResult& r) {
   std::string out = std::string("{\n  \"valid\": ") + (r.valid ? "true" : "false") + ",\n";
   out += "  \"message\": " + quoted(r.message) + ",\n";
-  out += format("  \"poses\": {\"ground_truth\": %zu, \"estimate\": %zu, \"matched\": %zu},\n", r.gt_poses,
-                r.est_poses, r.matched_poses);
+  out += format("  \"poses\": {\"ground_truth\": %zu, \"estimate\": %zu, \"matched\": %zu, \"non_finite_dropped\": %zu},\n",
+                r.gt_poses, r.est_poses, r.matched_poses, r.non_finite_dropped);
   out += "  \"alignment\": " + alignmentJson(r) + ",\n";
   out += "  \"ape_translation_m\": " + statsJson(r.ape_m) + ",\n";
   out += "  \"rpe\": [";

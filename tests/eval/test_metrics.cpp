@@ -231,6 +231,16 @@ TEST(Evaluate, DegenerateOrEmptyInputDoesNotCrash) {
   EXPECT_FALSE(r.message.empty());
   EXPECT_LT(r.ape_m.max, 1e-9);  // centroid match removes a pure offset
 
+  Trajectory with_nan = est;
+  with_nan[7].pose.translation().x() = std::nan("");
+  with_nan[9].pose.linear()(0, 0) = INFINITY;
+  const EvalResult n = evaluate(gt, with_nan);
+  ASSERT_TRUE(n.valid);
+  EXPECT_EQ(n.non_finite_dropped, 2u);
+  EXPECT_EQ(n.matched_poses, 48u);
+  EXPECT_LT(n.ape_m.max, 1e-9);
+  EXPECT_NE(n.message.find("2 matched pairs with non-finite poses ignored"), std::string::npos) << n.message;
+
   EXPECT_FALSE(evaluate({}, gt).valid);
   EXPECT_FALSE(evaluate(gt, {}).valid);
   const EvalResult one = evaluate(Trajectory(gt.begin(), gt.begin() + 1), Trajectory(est.begin(), est.begin() + 1));
