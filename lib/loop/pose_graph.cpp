@@ -109,6 +109,8 @@ PoseGraphReport PoseGraph::optimize(const PoseGraphConfig& config) {
   options.max_num_iterations = config.max_iterations;
   options.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
   options.num_threads = 1;  // deterministic
+  // A pose graph warm-started from odometry is well posed: start close to Gauss-Newton (fewer iterations).
+  options.initial_trust_region_radius = 1e8;
   options.logging_type = ceres::SILENT;
   ceres::Solver::Summary summary;
   ceres::Solve(options, &problem, &summary);

@@ -1,0 +1,97 @@
+// Loop-closure speed: Scan Context build + candidate search with 5,000 keyframes in the database (target
+// <= 2 ms), and optimisation of a 5,000-node pose graph with 20 loops (target < 1 s).
+#include "box_world.hpp"
+#include "loop/pose_graph.hpp"
+#include "loop/scan_context_database.hpp"
+
+#include <benchmark/benchmark.h>
+
+#include <cmath>
+#include <random>
+
+using namespace adit;
+
+namespace {
+
+// 5,000 keyframe contexts from 50 simulated roadway sweeps, each seen from 100 yaws/offsets.
+struct Database {
+  ScanContextConfig config;
+  ScanContextDatabase db{10, 50};
+  std::vector<Eigen::Vector3f> query_points;
+  Database() {
+    std::mt19937 rng(1);
+    std::uniform_real_distribution<float> yaw(-3.1f, 3.1f), off(-0.5f, 0.5f);
+    for (int place = 0; place < 50; ++place) {
+      const auto world = adit::testing::makeRoadway(static_cast<std::uint32_t>(place), 4.5 + 0.01 * place, 12, place % 4 == 0);
+      const auto pts = adit::testing::positions(
+          adit::testing::simulateSweep(world, adit::testing::poseXYYaw(0, 0, 1.8, 0), static_cast<std::uint32_t>(place)));
+      for (int view = 0; view < 100; ++view) {
+        const Eigen::Matrix3f R = Eigen::AngleAxisf(yaw(rng), Eigen::Vector3f::UnitZ()).toRotationMatrix();
+        const Eigen::Vector3f t(off(rng), off(rng), 0.0f);
+        std::vector<Eigen::Vector3f> moved;
+        moved.reserve(pts.size());
+        for (const auto& p : pts) moved.push_back(R * p + t);
+        db.add(ScanContext::build(moved, config), static_cast<std::int64_t>(db.size()) * 100000);
+      }
+    }
+    query_points = adit::testing::positions(adit::testing::simulateSweep(
+        adit::testing::makeRoadway(7, 4.57, 12, false), adit::testing::poseXYYaw(0.3, 0.1, 1.8, 1.0), 99));
+  }
+};
+
+void BM_ScanContextBuildAndQuery5000(benchmark::State& state) {
+  static Database d;
+  for (auto _ : state) {
+    const ScanContext sc = ScanContext::build(d.query_points, d.config);
+    auto candidates = d.db.query(sc, 50);
+    benchmark::DoNotOptimize(candidates);
+  }
+  state.counters["keyframes"] = d.db.size();
+  state.counters["points"] = static_cast<double>(d.query_points.size());
+}
+BENCHMARK(BM_ScanContextBuildAndQuery5000)->Unit(benchmark::kMillisecond);
+
+// A 5,000-node drifting trajectory (1 m steps, slow turns) with 20 loop edges to true relative poses.
+PoseGraph graph5000() {
+  std::vector<Eigen::Isometry3d> truth{Eigen::Isometry3d::Identity()};
+  for (int i = 1; i < 5000; ++i) {
+    Eigen::Isometry3d step = Eigen::Isometry3d::Identity();
+    step.translation().x() = 1.0;
+    step.linear() = Eigen::AngleAxisd(2.0 * M_PI / 250.0, Eigen::Vector3d::UnitZ()).toRotationMatrix();  // laps of 250 m
+    truth.push_back(truth.back() * step);
+  }
+  Matrix6d info = Matrix6d::Identity();
+  info.diagonal() << 2500, 2500, 2500, 250000, 250000, 250000;
+  PoseGraph g;
+  g.addNode(truth[0]);
+  for (int i = 1; i < 5000; ++i) {
+    Eigen::Isometry3d step = truth[static_cast<std::size_t>(i - 1)].inverse() * truth[static_cast<std::size_t>(i)];
+    step.linear() = step.linear() * Eigen::AngleAxisd(0.0005, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    g.addNode(g.pose(i - 1) * step);
+    g.addOdometryEdge(i - 1, i, step, info);
+  }
+  for (int k = 1; k <= 20; ++k) {  // each loop: a node and the same place one lap (250 nodes) earlier
+    const int q = 4999 - 240 * (k - 1), m = q - 250;
+    g.addLoopEdge(m, q, truth[static_cast<std::size_t>(m)].inverse() * truth[static_cast<std::size_t>(q)], info);
+  }
+  return g;
+}
+
+void BM_PoseGraph5000Nodes20Loops(benchmark::State& state) {
+  const PoseGraph initial = graph5000();
+  PoseGraphReport report;
+  for (auto _ : state) {
+    state.PauseTiming();
+    PoseGraph g = initial;
+    state.ResumeTiming();
+    report = g.optimize();
+    benchmark::DoNotOptimize(report);
+  }
+  state.counters["iterations"] = report.iterations;
+  state.counters["solved"] = report.solved ? 1 : 0;
+}
+BENCHMARK(BM_PoseGraph5000Nodes20Loops)->Unit(benchmark::kMillisecond);
+
+}  // namespace
+
+BENCHMARK_MAIN();
