@@ -55,6 +55,8 @@ LoamConfig loamFrom(const Config& c) {
   d.sectors = c.get(k + "sectors", d.sectors);
   d.edge_threshold = c.get(k + "edge_threshold", d.edge_threshold);
   d.surf_threshold = c.get(k + "surf_threshold", d.surf_threshold);
+  d.edge_min_offset = c.get(k + "edge_min_offset", d.edge_min_offset);
+  d.surf_max_offset = c.get(k + "surf_max_offset", d.surf_max_offset);
   d.max_sharp = c.get(k + "max_sharp", d.max_sharp);
   d.max_less_sharp = c.get(k + "max_less_sharp", d.max_less_sharp);
   d.max_flat = c.get(k + "max_flat", d.max_flat);
@@ -70,6 +72,7 @@ LinK3dConfig link3dFrom(const Config& c) {
   LinK3dConfig d;
   const std::string k = "features.link3d.";
   d.edge_threshold = c.get(k + "edge_threshold", d.edge_threshold);
+  d.edge_min_offset = c.get(k + "edge_min_offset", d.edge_min_offset);
   d.max_range = c.get(k + "max_range", d.max_range);
   d.sectors = c.get(k + "sectors", d.sectors);
   d.cluster_radial_tol = c.get(k + "cluster_radial_tol", d.cluster_radial_tol);

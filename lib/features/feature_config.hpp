@@ -81,6 +81,13 @@ struct LoamConfig {
   float edge_threshold = 0.3f;
   // features.loam.surf_threshold: below this a point may be flat (a 170 deg bend is 0.09).
   float surf_threshold = 0.1f;
+  // features.loam.edge_min_offset (m): an edge point must also lie this far from its neighbours' centroid
+  // (PointScores::offset). Range noise (1-2 cm on VLP-16 / HDL-64E) alone moves a point about its sigma;
+  // a 90 deg corner sits ~2 beam spacings off, so corners count from ~5 m on a VLP-16.
+  float edge_min_offset = 0.03f;
+  // features.loam.surf_max_offset (m): a point this close to its neighbours' centroid is flat whatever its
+  // ratio: near the sensor the beam spacing is below the noise and the ratio only measures noise.
+  float surf_max_offset = 0.01f;
   // features.loam.max_sharp / max_less_sharp / max_flat: per sector (A-LOAM: 2 / 20 / 4).
   int max_sharp = 2;
   int max_less_sharp = 20;
@@ -104,6 +111,9 @@ struct LoamConfig {
 struct LinK3dConfig {
   // features.link3d.edge_threshold: smoothness above which a valid point is a LinK3D edge point.
   float edge_threshold = 0.2f;
+  // features.link3d.edge_min_offset (m): noise floor as in LoamConfig, higher: keypoints should come from
+  // strong, repeatable structure (depth jumps, corners seen at range), not from noise that happens to cluster.
+  float edge_min_offset = 0.1f;
   // features.link3d.max_range (m): farther edge points are too sparse to cluster reliably.
   float max_range = 80.0f;
   // features.link3d.sectors: horizontal sectors the edge points are grouped into (paper eq. 2: 120).

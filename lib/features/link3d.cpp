@@ -15,28 +15,33 @@ struct Cluster {
   double sum_rxy = 0.0;
   int count = 0;
   std::bitset<128> rings;
+  double mean_x = 0.0, mean_y = 0.0, mean_rxy = 0.0;  // cached means (compared for every point)
 
   void add(const LidarPoint& p) {
-    sum += p.p.cast<double>();
-    sum_rxy += std::hypot(p.p.x(), p.p.y());
-    ++count;
-    rings.set(p.ring % 128);
+    Cluster single;
+    single.sum = p.p.cast<double>();
+    single.sum_rxy = std::sqrt(single.sum.x() * single.sum.x() + single.sum.y() * single.sum.y());
+    single.count = 1;
+    single.rings.set(p.ring % 128);
+    absorb(single);
   }
   void absorb(const Cluster& o) {
     sum += o.sum;
     sum_rxy += o.sum_rxy;
     count += o.count;
     rings |= o.rings;
+    mean_x = sum.x() / count;
+    mean_y = sum.y() / count;
+    mean_rxy = sum_rxy / count;
   }
-  double meanRxy() const { return sum_rxy / count; }
   Eigen::Vector3d mean() const { return sum / count; }
 };
 
 // Same object: similar horizontal range and horizontal means close. The reference code compares |dx| and
 // |dy| separately, which depends on the sensor's yaw; the horizontal distance does not.
 bool similar(const Cluster& a, const Cluster& b, float radial_tol, float xy_tol) {
-  const Eigen::Vector3d ma = a.mean(), mb = b.mean();
-  return std::fabs(a.meanRxy() - b.meanRxy()) < radial_tol && std::hypot(ma.x() - mb.x(), ma.y() - mb.y()) < xy_tol;
+  const double dx = a.mean_x - b.mean_x, dy = a.mean_y - b.mean_y;
+  return std::fabs(a.mean_rxy - b.mean_rxy) < radial_tol && dx * dx + dy * dy < static_cast<double>(xy_tol) * xy_tol;
 }
 
 // Edge points of each horizontal sector, in cloud order (ring by ring, firing order).
@@ -44,10 +49,11 @@ std::vector<std::vector<int>> edgePointsBySector(const RingCloud& c, const Point
   const int sectors = std::max(1, cfg.sectors);
   std::vector<std::vector<int>> by_sector(sectors);
   for (std::size_t i = 0; i < c.points.size(); ++i) {
-    if (!s.usable[i] || s.smoothness[i] <= cfg.edge_threshold) continue;
-    const float rxy = std::hypot(c.points[i].p.x(), c.points[i].p.y());
+    if (!s.usable[i] || s.smoothness[i] <= cfg.edge_threshold || s.offset[i] <= cfg.edge_min_offset) continue;
+    const Eigen::Vector3f& p = c.points[i].p;
+    const float rxy = std::sqrt(p.x() * p.x() + p.y() * p.y());
     if (rxy > cfg.max_range || rxy < 1e-3f) continue;
-    double a = s.azimuth[i];
+    double a = std::atan2(p.y(), p.x());
     if (a < 0.0) a += kTwoPi;
     by_sector[std::min(sectors - 1, static_cast<int>(a / kTwoPi * sectors))].push_back(static_cast<int>(i));
   }

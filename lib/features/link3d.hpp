@@ -19,7 +19,8 @@ struct LinK3dCluster {
   int rings = 0;  // distinct rings among its points
 };
 
-// Edge points: usable points with smoothness above cfg.edge_threshold within cfg.max_range (horizontal).
+// Edge points: usable points with smoothness above cfg.edge_threshold, offset above cfg.edge_min_offset,
+// within cfg.max_range (horizontal).
 // Stable keypoints need vertical structure: a merged cluster becomes a keypoint only with at least
 // min_cluster_points points over min_cluster_rings rings. Output order: by sector of the cluster's first part.
 std::vector<LinK3dCluster> extractLinK3dClusters(const RingCloud& cloud, const PointScores& scores,

@@ -3,7 +3,8 @@
 #include "features/preprocess.hpp"
 
 #include <algorithm>
-#include <numeric>
+#include <cstring>
+#include <functional>
 
 namespace adit::features {
 namespace {
@@ -32,30 +33,41 @@ struct RingSelection {
     }
   }
 
+  bool isEdge(int i) const {
+    return s.usable[i] && s.smoothness[i] > cfg.edge_threshold && s.offset[i] > cfg.edge_min_offset;
+  }
+  bool isFlat(int i) const {
+    return s.usable[i] && !isEdge(i) && (s.smoothness[i] < cfg.surf_threshold || s.offset[i] < cfg.surf_max_offset);
+  }
+
   void sector(int sp, int ep, LoamFeatures& out) const {
-    std::vector<int> order;
-    for (int i = sp; i < ep; ++i)
-      if (s.usable[i]) order.push_back(i);
-    // Ascending smoothness, ties by index: deterministic.
-    std::sort(order.begin(), order.end(), [&](int a, int k) {
-      return s.smoothness[a] < s.smoothness[k] || (s.smoothness[a] == s.smoothness[k] && a < k);
-    });
-    int edges = 0;
-    for (auto it = order.rbegin(); it != order.rend() && edges < cfg.max_less_sharp; ++it) {
-      const int i = *it;
-      if (s.smoothness[i] <= cfg.edge_threshold) break;
+    // Sort keys: smoothness bits (non-negative floats order like their bit patterns) above the index, so
+    // a plain integer sort orders by smoothness with ties by index: fast and deterministic.
+    std::vector<std::uint64_t> edges, flats;
+    for (int i = sp; i < ep; ++i) {
+      std::uint32_t bits;
+      std::memcpy(&bits, &s.smoothness[i], sizeof bits);
+      const std::uint64_t key = (static_cast<std::uint64_t>(bits) << 32) | static_cast<std::uint32_t>(i);
+      if (isEdge(i)) edges.push_back(key);
+      else if (isFlat(i)) flats.push_back(key);
+    }
+    std::sort(edges.begin(), edges.end(), std::greater<>());
+    std::sort(flats.begin(), flats.end());
+    int picked = 0;
+    for (std::size_t k = 0; k < edges.size() && picked < cfg.max_less_sharp; ++k) {
+      const int i = static_cast<int>(edges[k] & 0xFFFFFFFFu);
       if (taken[i]) continue;
-      ++edges;
-      if (edges <= cfg.max_sharp) out.sharp.push_back(c.points[i]);
+      ++picked;
+      if (picked <= cfg.max_sharp) out.sharp.push_back(c.points[i]);
       out.less_sharp.push_back(c.points[i]);
       label[i] = kEdge;
       suppress(i);
     }
-    int flats = 0;
-    for (int i : order) {
-      if (flats >= cfg.max_flat || s.smoothness[i] >= cfg.surf_threshold) break;
+    picked = 0;
+    for (std::size_t k = 0; k < flats.size() && picked < cfg.max_flat; ++k) {
+      const int i = static_cast<int>(flats[k] & 0xFFFFFFFFu);
       if (taken[i]) continue;
-      ++flats;
+      ++picked;
       out.flat.push_back(c.points[i]);
       label[i] = kFlat;
       suppress(i);
@@ -78,7 +90,7 @@ LoamFeatures selectLoamFeatures(const RingCloud& c, const PointScores& s, const 
     for (int k = 0; k < sectors; ++k)
       sel.sector(sp0 + (ep0 - sp0) * k / sectors, sp0 + (ep0 - sp0) * (k + 1) / sectors, out);
     for (int i = sp0; i < ep0; ++i)
-      if (s.usable[i] && label[i] != kEdge && s.smoothness[i] <= cfg.edge_threshold) less_flat.push_back(c.points[i]);
+      if (s.usable[i] && label[i] != kEdge && !sel.isEdge(i)) less_flat.push_back(c.points[i]);
   }
   out.less_flat = voxelDownsample(less_flat, cfg.less_flat_voxel);
   return out;

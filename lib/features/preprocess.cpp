@@ -76,7 +76,13 @@ RingCloud groupByRing(const std::vector<LidarPoint>& pts, int num_rings) {
   const auto by_time = [](const LidarPoint& a, const LidarPoint& b) { return a.dt < b.dt; };
   for (int r = 0; r < num_rings; ++r) {
     auto first = cloud.points.begin() + cloud.ring_begin[r], last = cloud.points.begin() + cloud.ring_begin[r + 1];
-    if (!std::is_sorted(first, last, by_time)) std::stable_sort(first, last, by_time);
+    if (std::is_sorted(first, last, by_time)) continue;
+    // A row that starts mid-sweep (KITTI) is two sorted runs: rotating them equals the stable sort.
+    const auto mid = std::min_element(first, last, by_time);
+    if (std::is_sorted(mid, last, by_time) && std::is_sorted(first, mid, by_time) && by_time(*(last - 1), *first))
+      std::rotate(first, mid, last);
+    else
+      std::stable_sort(first, last, by_time);
   }
   return cloud;
 }

@@ -6,29 +6,43 @@
 namespace adit::features {
 namespace {
 
-float azimuthGap(float a, float b) {
-  float d = std::fabs(a - b);
-  return d > static_cast<float>(M_PI) ? static_cast<float>(2.0 * M_PI) - d : d;
+// True if the horizontal directions of a and b differ by more than the angle whose sine is sin_max (or by
+// more than 90 deg): a gap of missing returns between consecutive points of a ring.
+bool azimuthGap(const Eigen::Vector3f& a, const Eigen::Vector3f& b, float sin_max) {
+  const float dot = a.x() * b.x() + a.y() * b.y(), cross = a.x() * b.y() - a.y() * b.x();
+  const float norms2 = (a.x() * a.x() + a.y() * a.y()) * (b.x() * b.x() + b.y() * b.y());
+  return dot <= 0.0f || cross * cross > sin_max * sin_max * norms2;
 }
 
-// Smoothness of points [b, e) of one ring; windows crossing a gap of missing returns are not evaluated.
+// Smoothness of points [b, e) of one ring in O(1) per point from prefix sums (doubles: a ring's sums reach
+// 1e5 m). The spread sum_j |p_j - p_i| is taken along the scan line (path length from p_i to p_j): equal to
+// the chord on straight runs and at corners, larger where noise makes the line zigzag, so noise alone reads
+// as less edge-like. Windows crossing a gap of missing returns are not evaluated.
 void scoreRing(const RingCloud& c, int b, int e, const LoamConfig& cfg, PointScores& s) {
-  const int w = cfg.half_window;
-  const float max_gap = cfg.max_neighbor_gap_deg * static_cast<float>(M_PI / 180.0);
-  // gaps_upto[k] = number of gaps between consecutive points among b..b+k
-  std::vector<int> gaps_upto(e - b, 0);
-  for (int i = b + 1; i < e; ++i)
-    gaps_upto[i - b] = gaps_upto[i - 1 - b] + (azimuthGap(s.azimuth[i], s.azimuth[i - 1]) > max_gap ? 1 : 0);
-  for (int i = b + w; i + w < e; ++i) {
-    if (gaps_upto[i + w - b] != gaps_upto[i - w - b]) continue;
-    Eigen::Vector3f sum = Eigen::Vector3f::Zero();
-    float spread = 0.0f;
-    for (int j = i - w; j <= i + w; ++j) {
-      const Eigen::Vector3f d = c.points[j].p - c.points[i].p;
-      sum += d;
-      spread += d.norm();
+  const int w = cfg.half_window, n = e - b;
+  const float sin_max = std::sin(std::min(cfg.max_neighbor_gap_deg, 89.0f) * static_cast<float>(M_PI / 180.0));
+  std::vector<int> gaps(n, 0);           // gaps[k]: gaps between consecutive points among b..b+k
+  std::vector<Eigen::Vector3d> P(n + 1);  // P[k] = sum of the first k points
+  std::vector<double> C(n, 0.0);          // C[k] = path length from b to b+k
+  std::vector<double> CC(n + 1, 0.0);     // CC[k] = sum of the first k path lengths
+  P[0].setZero();
+  for (int k = 0; k < n; ++k) {
+    const Eigen::Vector3f& p = c.points[b + k].p;
+    P[k + 1] = P[k] + p.cast<double>();
+    if (k > 0) {
+      const Eigen::Vector3f& q = c.points[b + k - 1].p;
+      gaps[k] = gaps[k - 1] + (azimuthGap(q, p, sin_max) ? 1 : 0);
+      C[k] = C[k - 1] + (p - q).norm();
     }
-    s.smoothness[i] = spread > 1e-6f ? sum.norm() / spread : 0.0f;
+    CC[k + 1] = CC[k] + C[k];
+  }
+  for (int l = w; l + w < n; ++l) {
+    if (gaps[l + w] != gaps[l - w]) continue;
+    const Eigen::Vector3d sum = (P[l + w + 1] - P[l - w]) - (2 * w + 1) * c.points[b + l].p.cast<double>();
+    const double spread = (CC[l + w + 1] - CC[l + 1]) - (CC[l] - CC[l - w]);
+    const double norm = sum.norm();
+    s.smoothness[b + l] = spread > 1e-6 ? static_cast<float>(norm / spread) : 0.0f;
+    s.offset[b + l] = static_cast<float>(norm / (2 * w));
   }
 }
 
@@ -55,13 +69,10 @@ PointScores scorePoints(const RingCloud& c, const LoamConfig& cfg) {
   const std::size_t n = c.points.size();
   PointScores s;
   s.range.resize(n);
-  s.azimuth.resize(n);
   s.smoothness.assign(n, -1.0f);
+  s.offset.assign(n, 0.0f);
   s.usable.assign(n, 1);
-  for (std::size_t i = 0; i < n; ++i) {
-    s.range[i] = c.points[i].p.norm();
-    s.azimuth[i] = std::atan2(c.points[i].p.y(), c.points[i].p.x());
-  }
+  for (std::size_t i = 0; i < n; ++i) s.range[i] = c.points[i].p.norm();
   for (int r = 0; r < c.numRings(); ++r) {
     const int b = c.ring_begin[r], e = c.ring_begin[r + 1];
     scoreRing(c, b, e, cfg, s);

@@ -11,13 +11,18 @@ namespace adit::features {
 
 struct PointScores {
   std::vector<float> range;       // |p| (m)
-  std::vector<float> azimuth;     // atan2(y, x) (rad)
   // Smoothness (LOAM paper eq. 1, normalised to be comparable across ranges and resolutions):
-  //   c_i = | sum_j (p_j - p_i) | / sum_j |p_j - p_i|   over the half_window neighbours on each side.
-  // LOAM divides the same sum by |S| |p_i|; dividing by the neighbours' spread instead removes both range
-  // (spread grows with range) and angular resolution (16 vs 64 beams), so one threshold fits every sensor.
+  //   c_i = | sum_j (p_j - p_i) | / sum_j L(i, j)   over the half_window neighbours on each side,
+  // L(i, j) the path length along the scan line from p_i to p_j (= |p_j - p_i| on straight runs and at
+  // corners). LOAM divides the same sum by |S| |p_i|; dividing by the neighbours' spread instead removes both
+  // range (spread grows with range) and angular resolution (16 vs 64 beams), so one threshold fits every
+  // sensor: 0 on a straight scan line, cos(a/2) at a corner of interior angle a.
   // -1 where the window is incomplete (ring ends, gaps of missing returns).
   std::vector<float> smoothness;
+  // |sum_j (p_j - p_i)| / (2 half_window): distance (m) from p_i to its neighbours' centroid. Range noise
+  // moves a point by about its own sigma, so an edge must also clear this noise floor: the scale-free
+  // ratio alone would call every point an edge where the beam spacing falls below the noise.
+  std::vector<float> offset;
   // 0 where the point must not become a feature: incomplete window, far side of a depth jump (occluded,
   // it moves with the viewpoint), or a surface nearly parallel to the beam.
   std::vector<std::uint8_t> usable;

@@ -51,7 +51,7 @@ TEST(LinK3dClusters, MergingAcrossASectorBorderDoesNotDuplicatePoints) {
   features::PointScores scores;
   for (const LidarPoint& p : cloud.points) {
     scores.range.push_back(p.p.norm());
-    scores.azimuth.push_back(std::atan2(p.p.y(), p.p.x()));
+    scores.offset.push_back(1.0f);
     scores.smoothness.push_back(0.9f);
     scores.usable.push_back(1);
   }
@@ -67,7 +67,7 @@ TEST(LinK3dClusters, MergingAcrossASectorBorderDoesNotDuplicatePoints) {
   cfg = LinK3dConfig{};
   cloud.points.resize(10);
   cloud.ring_begin = {0, 2, 4, 6, 8, 10};
-  for (auto* v : {&scores.range, &scores.azimuth, &scores.smoothness}) v->resize(10);
+  for (auto* v : {&scores.range, &scores.offset, &scores.smoothness}) v->resize(10);
   scores.usable.resize(10);
   EXPECT_EQ(features::extractLinK3dClusters(cloud, scores, cfg).size(), 1u);
   cloud.points.resize(6);  // 6 points over 3 rings: below min_cluster_points
