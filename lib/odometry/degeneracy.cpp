@@ -19,16 +19,16 @@ void analyzeBlock(const Eigen::Matrix3d& block, double ratio, Eigen::Vector3d& v
 
 }  // namespace
 
-DegeneracyReport analyzeDegeneracy(const Matrix6d& information, double min_eigenvalue_ratio) {
+DegeneracyReport analyzeDegeneracy(const Matrix6d& information, double translation_ratio, double rotation_ratio) {
   DegeneracyReport r;
   if (!information.allFinite()) {
     r.translation_degenerate = r.rotation_degenerate = {{true, true, true}};
     r.flags = PoseEstimate::kDegenerateTranslation | PoseEstimate::kDegenerateRotation;
     return r;
   }
-  analyzeBlock(information.topLeftCorner<3, 3>(), min_eigenvalue_ratio, r.translation_eigenvalues,
+  analyzeBlock(information.topLeftCorner<3, 3>(), translation_ratio, r.translation_eigenvalues,
                r.translation_directions, r.translation_degenerate);
-  analyzeBlock(information.bottomRightCorner<3, 3>(), min_eigenvalue_ratio, r.rotation_eigenvalues,
+  analyzeBlock(information.bottomRightCorner<3, 3>(), rotation_ratio, r.rotation_eigenvalues,
                r.rotation_directions, r.rotation_degenerate);
   const auto any = [](const std::array<bool, 3>& a) { return a[0] || a[1] || a[2]; };
   if (any(r.translation_degenerate)) r.flags |= PoseEstimate::kDegenerateTranslation;

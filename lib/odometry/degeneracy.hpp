@@ -21,7 +21,10 @@ struct DegeneracyReport {
   std::int32_t flags = 0;  // PoseEstimate::kDegenerateTranslation / kDegenerateRotation
 };
 
-DegeneracyReport analyzeDegeneracy(const Matrix6d& information, double min_eigenvalue_ratio);
+// Separate ratios because rotation information grows with the square of the lever arm: in a long roadway
+// yaw is observed by walls tens of metres away while roll only by the cross-section, a few metres, so a
+// well-determined roll sits (w/L)^2 ~ 1/300 below yaw. Its ratio must be lower to flag only real loss.
+DegeneracyReport analyzeDegeneracy(const Matrix6d& information, double translation_ratio, double rotation_ratio);
 
 // Covariance of the estimate: the inverse of the measurement information, where every degenerate direction
 // gets the motion model's information instead (1 / prior_sigma^2), so its variance is the prior's, never

@@ -82,7 +82,8 @@ RegistrationConfig registrationConfigFrom(const Config& c, const std::string& pr
   r.loss_scale_m = c.get<double>(key("loss_scale_m"), r.loss_scale_m);
   r.min_correspondences = c.get<int>(key("min_correspondences"), r.min_correspondences);
   r.point_sigma_m = c.get<double>(key("point_sigma_m"), r.point_sigma_m);
-  r.degeneracy_ratio = c.get<double>(key("degeneracy_ratio"), r.degeneracy_ratio);
+  r.degeneracy_ratio_translation = c.get<double>(key("degeneracy_ratio_translation"), r.degeneracy_ratio_translation);
+  r.degeneracy_ratio_rotation = c.get<double>(key("degeneracy_ratio_rotation"), r.degeneracy_ratio_rotation);
   r.degeneracy_prior = c.get<bool>(key("degeneracy_prior"), r.degeneracy_prior);
   r.degeneracy_prior_strength = c.get<double>(key("degeneracy_prior_strength"), r.degeneracy_prior_strength);
   r.prior_sigma_translation_m = c.get<double>(key("prior_sigma_translation_m"), r.prior_sigma_translation_m);
@@ -106,7 +107,7 @@ RegistrationResult registerStep(const Correspondences& matches, const Eigen::Iso
 
   // Degeneracy at the linearisation point decides where the motion prior applies during this round.
   const Matrix6d H0 = informationOf(problem, ids, config.point_sigma_m);
-  const DegeneracyReport d0 = analyzeDegeneracy(H0, config.degeneracy_ratio);
+  const DegeneracyReport d0 = analyzeDegeneracy(H0, config.degeneracy_ratio_translation, config.degeneracy_ratio_rotation);
   if (config.degeneracy_prior && d0.flags != 0 && isFinitePose(motion_prior))
     addDirectionalPriors(problem, xi, d0, incrementBetween(T0, motion_prior), config);
 
@@ -123,7 +124,8 @@ RegistrationResult registerStep(const Correspondences& matches, const Eigen::Iso
   if (!solution.allFinite()) return result;
   // Report information and degeneracy at the solution, from the measurements only.
   result.information = informationOf(problem, ids, config.point_sigma_m);
-  result.degeneracy = analyzeDegeneracy(result.information, config.degeneracy_ratio);
+  result.degeneracy = analyzeDegeneracy(result.information, config.degeneracy_ratio_translation,
+                                        config.degeneracy_ratio_rotation);
   result.pose = applyIncrement(T0, solution);
   result.iterations = static_cast<int>(summary.iterations.size());
   result.final_cost = summary.final_cost;

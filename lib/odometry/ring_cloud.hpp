@@ -22,6 +22,8 @@ class RingIndexedCloud {
     return all_.nearestK(q, k, max_sq_distance);
   }
   int nearestInRing(int ring, const Eigen::Vector3d& q, double max_sq_distance, int exclude) const;
+  // Up to k nearest points of one ring, nearest first.
+  std::vector<int> nearestKInRing(int ring, const Eigen::Vector3d& q, int k, double max_sq_distance) const;
   // Nearest over rings ring-window .. ring+window, excluding `ring` itself.
   int nearestInNeighbourRings(int ring, int window, const Eigen::Vector3d& q, double max_sq_distance) const;
 

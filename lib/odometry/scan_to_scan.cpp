@@ -3,6 +3,8 @@
 #include "odometry/feature_fit.hpp"
 #include "odometry/pose_increment.hpp"
 
+#include <algorithm>
+
 namespace adit {
 namespace {
 
@@ -27,7 +29,7 @@ ScanToScanConfig scanToScanConfigFrom(const Config& c) {
   s.ring_window = c.get<int>("odometry.ring_window", s.ring_window);
   s.plane_neighbours = c.get<int>("odometry.plane_neighbours", s.plane_neighbours);
   s.plane_max_point_distance_m = c.get<double>("odometry.plane_max_point_distance_m", s.plane_max_point_distance_m);
-  s.three_point_planes = c.get<bool>("odometry.three_point_planes", s.three_point_planes);
+  s.ring_neighbours = c.get<int>("odometry.ring_neighbours", s.ring_neighbours);
   s.use_link3d_seed = c.get<bool>("odometry.use_link3d_seed", s.use_link3d_seed);
   s.max_velocity_gap_s = c.get<double>("odometry.max_velocity_gap_s", s.max_velocity_gap_s);
   return s;
@@ -42,6 +44,29 @@ Eigen::Isometry3d ScanToScanOdometry::predictMotion(std::int64_t utime) const {
   if (!has_previous_ || last_gap_us_ <= 0 || gap <= 0 || toSeconds(gap) > config_.max_velocity_gap_s)
     return Eigen::Isometry3d::Identity();
   return scaleMotion(last_motion_, static_cast<double>(gap) / static_cast<double>(last_gap_us_));
+}
+
+std::optional<PlaneFit> ScanToScanOdometry::fitLocalPlane(const Eigen::Vector3d& q, double max_sq) const {
+  // The nearest previous surface points, plus the nearest few on each neighbouring ring of the closest one:
+  // a sparse sweep's nearest points often lie on one ring (collinear, so the plane's tilt about that line
+  // would be noise). A-LOAM takes a single point from the neighbouring ring, which near a wall-floor junction
+  // is often on the other face; several points per ring and the outlier check of fitPlane reject that.
+  std::vector<int> near = prev_surfs_.nearestK(q, config_.plane_neighbours, max_sq);
+  if (near.empty()) return std::nullopt;
+  const int ring = prev_surfs_.ring(near.front());
+  for (int r = ring - config_.ring_window; r <= ring + config_.ring_window; ++r) {
+    if (r == ring) continue;
+    for (int i : prev_surfs_.nearestKInRing(r, q, config_.ring_neighbours, max_sq))
+      if (std::find(near.begin(), near.end(), i) == near.end()) near.push_back(i);
+  }
+  std::vector<Eigen::Vector3d> pts;
+  bool several_rings = false;
+  for (int i : near) {
+    pts.push_back(prev_surfs_.point(i));
+    several_rings = several_rings || prev_surfs_.ring(i) != ring;
+  }
+  if (!several_rings) return std::nullopt;
+  return fitPlane(pts, config_.plane_max_point_distance_m);
 }
 
 Correspondences ScanToScanOdometry::match(const FeatureSet& f, const Eigen::Isometry3d& T) const {
@@ -61,36 +86,7 @@ Correspondences ScanToScanOdometry::match(const FeatureSet& f, const Eigen::Isom
   for (const LidarPoint& lp : f.surf_flat) {
     if (!lp.p.allFinite()) continue;
     const Eigen::Vector3d p = lp.p.cast<double>(), q = T * p;
-    // Preferred: a least-squares plane through several neighbours (robust to range noise, which tilts a
-    // three-point plane badly when its points are close together).
-    const auto near = prev_surfs_.nearestK(q, config_.plane_neighbours, max_sq);
-    std::vector<Eigen::Vector3d> pts;
-    bool several_rings = false;
-    for (int i : near) {
-      pts.push_back(prev_surfs_.point(i));
-      several_rings = several_rings || prev_surfs_.ring(i) != prev_surfs_.ring(near.front());
-    }
-    // Neighbours all on one ring are (nearly) collinear: the plane's tilt about that line would be noise.
-    if (several_rings && static_cast<int>(pts.size()) == config_.plane_neighbours) {
-      if (const auto plane = fitPlane(pts, config_.plane_max_point_distance_m)) {
-        m.planes.push_back({p, plane->normal, plane->offset});
-        continue;
-      }
-    }
-    // Fallback when the neighbours are collinear (one ring of a sparse sweep): A-LOAM's three points, the
-    // nearest, its nearest on the same ring and the nearest on a neighbouring ring.
-    const int j = near.empty() ? -1 : near.front();
-    if (j < 0 || !config_.three_point_planes) continue;
-    const int ring = prev_surfs_.ring(j);
-    const int l = prev_surfs_.nearestInRing(ring, q, max_sq, j);
-    const int k = prev_surfs_.nearestInNeighbourRings(ring, config_.ring_window, q, max_sq);
-    if (l < 0 || k < 0) continue;
-    const Eigen::Vector3d a = prev_surfs_.point(j), b = prev_surfs_.point(l), c = prev_surfs_.point(k);
-    const Eigen::Vector3d cross = (b - a).cross(c - a);
-    // Reject near-collinear triples: their normal is noise.
-    if (cross.norm() < 0.1 * (b - a).norm() * (c - a).norm() || cross.norm() < 1e-9) continue;
-    const Eigen::Vector3d n = cross.normalized();
-    m.planes.push_back({p, n, -n.dot(a)});
+    if (const auto plane = fitLocalPlane(q, max_sq)) m.planes.push_back({p, plane->normal, plane->offset});
   }
   return m;
 }

@@ -6,6 +6,7 @@
 
 #include "core/config.hpp"
 #include "core/types.hpp"
+#include "odometry/feature_fit.hpp"
 #include "odometry/registration.hpp"
 #include "odometry/ring_cloud.hpp"
 
@@ -22,12 +23,14 @@ struct ScanToScanConfig {
   double max_match_distance_m = 3.0;
   // Rings either side searched for the second line point / third plane point (A-LOAM: 2.5 -> 2).
   int ring_window = 2;
-  // Planes are fitted to this many nearest previous less-flat points (least squares, rejected if any is
-  // farther than plane_max_point_distance_m from the plane, A-LOAM mapping's 0.2 m); when they are collinear
-  // the A-LOAM three-point plane is used instead.
+  // Planes are fitted (least squares) to the plane_neighbours nearest previous less-flat points plus the
+  // ring_neighbours nearest on each ring within ring_window of the closest one, and rejected if any of them
+  // is farther than plane_max_point_distance_m from the plane (A-LOAM mapping uses 0.2 m; tighter here
+  // because a plane straddling a wall-floor junction must be caught: with 0.2 m, 2% of corridor planes were
+  // tilted by such straddles).
   int plane_neighbours = 5;
-  double plane_max_point_distance_m = 0.2;
-  bool three_point_planes = true;
+  int ring_neighbours = 3;
+  double plane_max_point_distance_m = 0.1;
   // Accept a prior flagged kSeededByLinK3d as initial guess (false = A-LOAM ablation: motion model only).
   bool use_link3d_seed = true;
   // Longest gap between sweeps (s) over which the constant-velocity model extrapolates; beyond, no motion.
@@ -60,6 +63,8 @@ class ScanToScanOdometry {
   void reset();
 
  private:
+  std::optional<PlaneFit> fitLocalPlane(const Eigen::Vector3d& q, double max_sq) const;
+
   ScanToScanConfig config_;
   RingIndexedCloud prev_corners_;  // previous corner_less_sharp, previous lidar frame
   RingIndexedCloud prev_surfs_;    // previous surf_less_flat

@@ -1,5 +1,6 @@
 #include "synthetic_world.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <random>
@@ -25,12 +26,41 @@ double hitDistance(const Box& b, const Eigen::Vector3d& o, const Eigen::Vector3d
   return t_near > 1e-6 ? t_near : std::numeric_limits<double>::infinity();
 }
 
-// A hit near two faces of its box lies on an edge of that box.
-bool onEdge(const Box& b, const Eigen::Vector3d& p, double band) {
-  int near_faces = 0;
-  for (int i = 0; i < 3; ++i)
-    if (std::abs(p[i] - b.min[i]) < band || std::abs(p[i] - b.max[i]) < band) ++near_faces;
-  return near_faces >= 2;
+// Distance of a hit to the nearest edge of its box: the second-smallest distance to a face plane.
+double edgeDistance(const Box& b, const Eigen::Vector3d& p) {
+  double d[3];
+  for (int i = 0; i < 3; ++i) d[i] = std::min(std::abs(p[i] - b.min[i]), std::abs(p[i] - b.max[i]));
+  std::sort(d, d + 3);
+  return d[1];
+}
+
+struct Hit {
+  LidarPoint point;
+  double edge_distance;
+};
+
+// Labels one ring like a LOAM extractor would: along the ring, a run of hits near a box edge is one
+// high-curvature spot; its hit closest to the edge is sharp, that hit and its run neighbours are less sharp.
+// Every other hit is a surface point, a regular subset flat.
+void labelRing(const std::vector<Hit>& ring, double band, FeatureSet& f) {
+  int surf_count = 0;
+  for (std::size_t i = 0; i < ring.size();) {
+    if (ring[i].edge_distance >= band) {
+      if (surf_count % 4 == 0) f.surf_less_flat.push_back(ring[i].point);
+      if (surf_count % 48 == 0) f.surf_flat.push_back(ring[i].point);
+      ++surf_count, ++i;
+      continue;
+    }
+    std::size_t end = i, best = i;
+    while (end < ring.size() && ring[end].edge_distance < band) {
+      if (ring[end].edge_distance < ring[best].edge_distance) best = end;
+      ++end;
+    }
+    f.corner_sharp.push_back(ring[best].point);
+    for (std::size_t k = (best > i ? best - 1 : best); k <= std::min(best + 1, end - 1); ++k)
+      f.corner_less_sharp.push_back(ring[k].point);
+    i = end;
+  }
 }
 
 bool nearRange(const Box& b, const Eigen::Vector3d& o, double range) {
@@ -96,7 +126,7 @@ FeatureSet simulateSweep(const World& world, const Eigen::Isometry3d& T, const L
   for (int ring = 0; ring < lidar.beams; ++ring) {
     const double el = (lidar.min_elevation_deg + (lidar.max_elevation_deg - lidar.min_elevation_deg) * ring /
                                                      std::max(1, lidar.beams - 1)) * deg;
-    int surf_count = 0, corner_count = 0;
+    std::vector<Hit> hits;
     for (int a = 0; a < lidar.azimuth_steps; ++a) {
       const double az = 2.0 * M_PI * a / lidar.azimuth_steps;
       const Eigen::Vector3d dir_l(std::cos(el) * std::cos(az), std::cos(el) * std::sin(az), std::sin(el));
@@ -108,20 +138,13 @@ FeatureSet simulateSweep(const World& world, const Eigen::Isometry3d& T, const L
         if (t < best) best = t, hit = b;
       }
       if (!hit || best > lidar.max_range) continue;
-      const bool edge = onEdge(*hit, origin + best * dir_w, lidar.edge_band);
       LidarPoint p;
       p.p = ((best + noise(rng)) * dir_l).cast<float>();
       p.ring = static_cast<std::uint16_t>(ring);
       f.cloud.points.push_back(p);
-      if (edge) {
-        f.corner_less_sharp.push_back(p);
-        if (corner_count++ % 5 == 0) f.corner_sharp.push_back(p);
-      } else {
-        if (surf_count % 4 == 0) f.surf_less_flat.push_back(p);
-        if (surf_count % 48 == 0) f.surf_flat.push_back(p);
-        ++surf_count;
-      }
+      hits.push_back({p, edgeDistance(*hit, origin + best * dir_w)});
     }
+    labelRing(hits, lidar.edge_band, f);
   }
   return f;
 }
