@@ -11,6 +11,7 @@
 
 Exit codes: 0 ok, 2 bad arguments or data, 3 matplotlib/numpy missing.
 """
+import os
 import sys
 
 
@@ -70,7 +71,7 @@ def plot_trajectory(data_path, out_path, title):
     ax_err.legend(loc="best", fontsize=8)
     ax_err.set_title("APE over time")
     fig.tight_layout()
-    fig.savefig(out_path, dpi=110)
+    save(fig, out_path)
 
 
 def plot_map(points_path, out_path, title, traj_path):
@@ -100,7 +101,14 @@ def plot_map(points_path, out_path, title, traj_path):
     ax.set_aspect("equal")
     ax.set_title("%s (%d points)" % (title, pts.shape[0]))
     fig.tight_layout()
-    fig.savefig(out_path, dpi=110)
+    save(fig, out_path)
+
+
+def save(fig, out_path):
+    """Write atomically: a reader never sees a half-written PNG."""
+    tmp = out_path + ".tmp"
+    fig.savefig(tmp, dpi=110, format="png")
+    os.replace(tmp, out_path)
 
 
 def main(argv):
@@ -113,4 +121,7 @@ def main(argv):
 
 
 if __name__ == "__main__":
-    main(sys.argv)
+    try:
+        main(sys.argv)
+    except Exception as e:  # one clear line for the C++ caller instead of a traceback
+        fail(2, "%s: %s" % (type(e).__name__, e))
