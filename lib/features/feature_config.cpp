@@ -94,6 +94,7 @@ RansacConfig ransacFrom(const Config& c) {
   d.inlier_threshold = c.get(k + "inlier_threshold", d.inlier_threshold);
   d.min_inliers = c.get(k + "min_inliers", d.min_inliers);
   d.robust_scale = c.get(k + "robust_scale", d.robust_scale);
+  d.min_sample_area = c.get(k + "min_sample_area", d.min_sample_area);
   d.seed = c.get(k + "seed", d.seed);
   return d;
 }

@@ -148,6 +148,9 @@ struct RansacConfig {
   float inlier_threshold = 0.5f;
   // features.ransac.min_inliers: fewer inliers means no reliable transform (ok = false).
   int min_inliers = 5;
+  // features.ransac.min_sample_area (m^2): a 3-point hypothesis whose triangle is smaller (nearly
+  // collinear keypoints) fixes the rotation badly and is skipped.
+  float min_sample_area = 0.25f;
   // features.ransac.robust_scale (m): Cauchy scale of the final weighted refit. Centroids that agree to
   // centimetres dominate; a centroid 0.3 m off (its cluster cut differently in the other sweep) gets weight 0.1.
   float robust_scale = 0.1f;

@@ -11,6 +11,29 @@ namespace {
 
 enum Label : std::uint8_t { kNone = 0, kEdge = 1, kFlat = 2 };
 
+// Sorted access to unique keys without sorting them all: only the first `prefix` are ordered up front
+// (the picks rarely need more: each pick suppresses at most 2 half_window neighbours); the rest is sorted
+// the first time it is reached. Same order as a full sort.
+template <class Compare>
+class SortedPrefix {
+ public:
+  SortedPrefix(std::vector<std::uint64_t>& keys, std::size_t prefix) : keys_(keys), sorted_(std::min(prefix, keys.size())) {
+    if (sorted_ < keys_.size()) std::nth_element(keys_.begin(), keys_.begin() + sorted_, keys_.end(), Compare{});
+    std::sort(keys_.begin(), keys_.begin() + sorted_, Compare{});
+  }
+  std::uint64_t at(std::size_t k) {
+    if (k >= sorted_) {
+      std::sort(keys_.begin() + sorted_, keys_.end(), Compare{});
+      sorted_ = keys_.size();
+    }
+    return keys_[k];
+  }
+
+ private:
+  std::vector<std::uint64_t>& keys_;
+  std::size_t sorted_;
+};
+
 struct RingSelection {
   const RingCloud& c;
   const PointScores& s;
@@ -51,11 +74,11 @@ struct RingSelection {
       if (isEdge(i)) edges.push_back(key);
       else if (isFlat(i)) flats.push_back(key);
     }
-    std::sort(edges.begin(), edges.end(), std::greater<>());
-    std::sort(flats.begin(), flats.end());
+    SortedPrefix<std::greater<>> edge_order(edges, static_cast<std::size_t>(cfg.max_less_sharp) * (2 * cfg.half_window + 1));
+    SortedPrefix<std::less<>> flat_order(flats, static_cast<std::size_t>(cfg.max_flat) * (2 * cfg.half_window + 1) + 64);
     int picked = 0;
     for (std::size_t k = 0; k < edges.size() && picked < cfg.max_less_sharp; ++k) {
-      const int i = static_cast<int>(edges[k] & 0xFFFFFFFFu);
+      const int i = static_cast<int>(edge_order.at(k) & 0xFFFFFFFFu);
       if (taken[i]) continue;
       ++picked;
       if (picked <= cfg.max_sharp) out.sharp.push_back(c.points[i]);
@@ -65,7 +88,7 @@ struct RingSelection {
     }
     picked = 0;
     for (std::size_t k = 0; k < flats.size() && picked < cfg.max_flat; ++k) {
-      const int i = static_cast<int>(flats[k] & 0xFFFFFFFFu);
+      const int i = static_cast<int>(flat_order.at(k) & 0xFFFFFFFFu);
       if (taken[i]) continue;
       ++picked;
       out.flat.push_back(c.points[i]);
@@ -81,6 +104,7 @@ LoamFeatures selectLoamFeatures(const RingCloud& c, const PointScores& s, const 
   LoamFeatures out;
   std::vector<std::uint8_t> taken(c.points.size(), 0), label(c.points.size(), kNone);
   std::vector<LidarPoint> less_flat;
+  less_flat.reserve(c.points.size());
   const int sectors = std::max(1, cfg.sectors);
   for (int r = 0; r < c.numRings(); ++r) {
     const int b = c.ring_begin[r], e = c.ring_begin[r + 1];

@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
-#include <unordered_map>
 
 namespace adit::features {
 namespace {
@@ -165,31 +164,37 @@ RingCloud preprocessScan(const LidarScan& scan, const PreprocessConfig& cfg, Pre
 }
 
 std::vector<LidarPoint> voxelDownsample(const std::vector<LidarPoint>& points, float leaf) {
-  if (!(leaf > 0.0f)) return points;
-  struct Acc {
-    Eigen::Vector3f sum;
-    int count;
-  };
-  std::unordered_map<std::int64_t, int> slot_of;  // lookup only; output order is first occurrence
-  std::vector<Acc> acc;
+  if (!(leaf > 0.0f) || points.empty()) return points;
+  // Open-addressing table voxel key -> output slot, used for lookup only: the output is in order of first
+  // occurrence, so the result does not depend on hashing. Node-free: no allocation per voxel.
+  std::size_t capacity = 16;
+  while (capacity < 2 * points.size()) capacity <<= 1;
+  constexpr std::uint64_t kEmpty = ~std::uint64_t{0};
+  std::vector<std::uint64_t> keys(capacity, kEmpty);
+  std::vector<int> slots(capacity, -1);
   std::vector<LidarPoint> out;
-  slot_of.reserve(points.size());
+  std::vector<Eigen::Vector3f> sums;
+  std::vector<int> counts;
   const float inv = 1.0f / leaf;
   for (const LidarPoint& p : points) {
     const Eigen::Array3f q = (p.p.array() * inv).floor();
-    const std::int64_t key = ((static_cast<std::int64_t>(q.x()) & 0x1FFFFF) << 42) |
-                             ((static_cast<std::int64_t>(q.y()) & 0x1FFFFF) << 21) |
-                             (static_cast<std::int64_t>(q.z()) & 0x1FFFFF);
-    const auto [it, inserted] = slot_of.emplace(key, static_cast<int>(out.size()));
-    if (inserted) {
+    const std::uint64_t key = ((static_cast<std::uint64_t>(static_cast<std::int64_t>(q.x())) & 0x1FFFFF) << 42) |
+                              ((static_cast<std::uint64_t>(static_cast<std::int64_t>(q.y())) & 0x1FFFFF) << 21) |
+                              (static_cast<std::uint64_t>(static_cast<std::int64_t>(q.z())) & 0x1FFFFF);
+    std::size_t h = (key * 0x9E3779B97F4A7C15ull) >> 20 & (capacity - 1);
+    while (keys[h] != kEmpty && keys[h] != key) h = (h + 1) & (capacity - 1);
+    if (keys[h] == kEmpty) {
+      keys[h] = key;
+      slots[h] = static_cast<int>(out.size());
       out.push_back(p);
-      acc.push_back({p.p, 1});
+      sums.push_back(p.p);
+      counts.push_back(1);
     } else {
-      acc[it->second].sum += p.p;
-      ++acc[it->second].count;
+      sums[slots[h]] += p.p;
+      ++counts[slots[h]];
     }
   }
-  for (std::size_t k = 0; k < out.size(); ++k) out[k].p = acc[k].sum / static_cast<float>(acc[k].count);
+  for (std::size_t k = 0; k < out.size(); ++k) out[k].p = sums[k] / static_cast<float>(counts[k]);
   return out;
 }
 
