@@ -3,6 +3,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <cstdlib>
+#include <optional>
 #include <stdexcept>
 
 namespace adit::launch {
@@ -21,11 +22,18 @@ std::string substitute(const std::string& text, const std::map<std::string, std:
     const std::size_t end = text.find('}', start);
     if (end == std::string::npos) throw std::runtime_error(where + ": unclosed ${ in '" + text + "'");
     out += text.substr(i, start - i);
-    const std::string name = text.substr(start + 2, end - start - 2);
+    std::string name = text.substr(start + 2, end - start - 2);
+    std::optional<std::string> fallback;  // ${VAR:-default}
+    if (const auto dash = name.find(":-"); dash != std::string::npos) {
+      fallback = name.substr(dash + 2);
+      name.resize(dash);
+    }
     if (auto it = vars.find(name); it != vars.end()) {
       out += it->second;
     } else if (const char* env = std::getenv(name.c_str())) {
       out += env;
+    } else if (fallback) {
+      out += *fallback;
     } else {
       throw std::runtime_error(where + ": variable ${" + name + "} is not set (pass --set " + name + "=...)");
     }

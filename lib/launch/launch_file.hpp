@@ -25,7 +25,7 @@ struct LaunchSpec {
   double grace_s = 2.0;                  // after such an exit, let the rest drain before stopping
 };
 
-// Reads a launch file, substituting ${VAR} from `vars` first, then the environment. Throws
+// Reads a launch file, substituting ${VAR} (or ${VAR:-default}) from `vars` first, then the environment. Throws
 // std::runtime_error naming the file and the problem (unknown variable, missing field, bad value).
 LaunchSpec loadLaunchFile(const std::string& path, const std::map<std::string, std::string>& vars);
 

@@ -1,5 +1,7 @@
 #include "nodes/registry.hpp"
 
+#include "nodes/feature_node.hpp"
+#include "nodes/loop_closer_node.hpp"
 #include "runtime/process.hpp"
 
 namespace adit::nodes {
@@ -9,15 +11,13 @@ const std::vector<std::string>& pipelineNodeNames() {
   return names;
 }
 
-std::unique_ptr<runtime::Node> makeNode(const std::string& name, const Config& /*config*/) {
-  if (name == "feature")
-    throw runtime::StageNotImplemented("the feature stage (preprocessing, deskew, LOAM, LinK3D) is not written yet: issue 4");
+std::unique_ptr<runtime::Node> makeNode(const std::string& name, const Config& config) {
+  if (name == "feature") return makeFeatureNode(config);
   if (name == "odometry")
     throw runtime::StageNotImplemented("the scan-to-scan odometry stage is not written yet: issue 5");
   if (name == "mapper")
     throw runtime::StageNotImplemented("the scan-to-map mapping stage is not written yet: issue 5");
-  if (name == "loop_closer")
-    throw runtime::StageNotImplemented("the loop-closure stage (Scan Context + pose graph) is not written yet: issue 6");
+  if (name == "loop_closer") return makeLoopCloserNode(config);
   throw std::runtime_error("no pipeline node named '" + name + "'");
 }
 

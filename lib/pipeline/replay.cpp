@@ -1,5 +1,8 @@
 #include "pipeline/replay.hpp"
 
+#include "io/atomic_file.hpp"
+#include "msg/type_name.hpp"
+#include "nodes/products.hpp"
 #include "nodes/registry.hpp"
 #include "runtime/lcm_log.hpp"
 #include "runtime/lockstep.hpp"
@@ -47,16 +50,6 @@ std::string timingJson(const ReplayReport& r) {
   return out;
 }
 
-void writeText(const fs::path& path, const std::string& text) {
-  const fs::path tmp = path.string() + ".tmp";
-  {
-    std::ofstream f(tmp, std::ios::binary | std::ios::trunc);
-    f << text;
-    if (!f) throw std::runtime_error("cannot write '" + tmp.string() + "'");
-  }
-  fs::rename(tmp, path);
-}
-
 }  // namespace
 
 ReplayReport runReplay(const ReplayOptions& options) {
@@ -87,6 +80,7 @@ ReplayReport runReplay(const ReplayOptions& options) {
   std::int64_t first_utime = -1, last_utime = -1;
   while (!runtime::stopRequested() && input.next(event)) {
     ++report.input_events;
+    if (msg::messageTypeName(event.data.data(), event.data.size()) == "point_cloud_t") ++report.sweeps;
     if (first_utime < 0) first_utime = event.timestamp;
     last_utime = std::max(last_utime, event.timestamp);
     bus.inject(event.channel, event.data, event.timestamp);
@@ -108,8 +102,16 @@ ReplayReport runReplay(const ReplayOptions& options) {
   report.sensor_seconds = first_utime >= 0 ? static_cast<double>(last_utime - first_utime) * 1e-6 : 0.0;
   report.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
   report.peak_memory_mb = peakMemoryMb();
+  // Products in pipeline order: a later stage's file replaces an earlier one's (see nodes/products.hpp).
+  for (const auto& node : nodes) {
+    auto* writer = dynamic_cast<nodes::WritesProducts*>(node.get());
+    if (writer && node->health().inputs > 0)
+      for (const auto& path : writer->writeProducts(options.out_dir))
+        if (std::find(report.products.begin(), report.products.end(), path) == report.products.end())
+          report.products.push_back(path);
+  }
   const fs::path timing_path = fs::path(options.out_dir) / "timing.json";
-  writeText(timing_path, timingJson(report));
+  io::writeFileAtomically(timing_path.string(), timingJson(report));
   report.products.push_back(timing_path.string());
   return report;
 }

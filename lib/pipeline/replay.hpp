@@ -39,7 +39,7 @@ struct ReplayReport {
   std::int64_t corrupt_frames = 0;
   bool truncated = false;
   std::int64_t stage_errors = 0;  // errors + drops counted by the stages
-  std::int64_t sweeps = 0;        // poses in the trajectory
+  std::int64_t sweeps = 0;        // lidar sweeps in the input
   double sensor_seconds = 0;      // span of sensor time in the input
   double wall_seconds = 0;
   double peak_memory_mb = 0;

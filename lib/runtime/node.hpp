@@ -67,6 +67,8 @@ class Node {
   void publish(const std::string& port, Msg& msg);
 
   void count(const std::string& counter, std::int64_t n = 1) { health_.counters[counter] += n; }
+  // For counters a stage keeps itself: report its current value.
+  void setCount(const std::string& counter, std::int64_t value) { health_.counters[counter] = value; }
   // Count an input that could not be used (errors) or was skipped (drops), with one log line.
   void reportError(const std::string& counter, const std::string& message);
   void reportDrop(const std::string& counter, const std::string& message);

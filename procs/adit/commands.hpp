@@ -6,6 +6,7 @@
 #include <string>
 
 void registerImportCommand(CLI::App& app);
+void registerInfoCommand(CLI::App& app);
 void registerReplayCommand(CLI::App& app);
 void registerLaunchCommand(CLI::App& app);
 void registerSpyCommand(CLI::App& app);

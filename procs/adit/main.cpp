@@ -17,6 +17,7 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   spdlog::set_pattern("%H:%M:%S.%e %^%l%$ adit: %v");
   registerImportCommand(app);
+  registerInfoCommand(app);
   registerReplayCommand(app);
   registerLaunchCommand(app);
   registerSpyCommand(app);

@@ -1,0 +1,19 @@
+// Files a node leaves behind at the end of a run (map, trajectories, graph). `adit replay` asks every node
+// that implements this, in pipeline order, so a later stage's product replaces an earlier one's: the
+// mapper writes map.pcd, odometry.tum and trajectory.tum; the loop closer then rewrites trajectory.tum and
+// map.pcd from the corrected keyframe poses.
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace adit::nodes {
+
+class WritesProducts {
+ public:
+  virtual ~WritesProducts() = default;
+  // Writes atomically into out_dir; returns the paths written.
+  virtual std::vector<std::string> writeProducts(const std::string& out_dir) = 0;
+};
+
+}  // namespace adit::nodes

@@ -1,0 +1,46 @@
+// adit info <log>: what an LCM log holds, per channel: message count, type, time span and rate.
+#include "commands.hpp"
+
+#include "msg/type_name.hpp"
+#include "runtime/lcm_log.hpp"
+
+#include <fmt/format.h>
+
+#include <map>
+
+namespace {
+
+struct ChannelStats {
+  std::int64_t count = 0, bytes = 0, first = 0, last = 0;
+  std::string type;
+};
+
+}  // namespace
+
+void registerInfoCommand(CLI::App& app) {
+  auto path = std::make_shared<std::string>();
+  auto* cmd = app.add_subcommand("info", "Summarise an LCM log: messages, type, time span and rate per channel");
+  cmd->add_option("log", *path, "LCM log")->required()->check(CLI::ExistingFile);
+  cmd->callback([path] {
+    adit::runtime::LogReader reader(*path);
+    std::map<std::string, ChannelStats> channels;
+    adit::runtime::LogEvent e;
+    while (reader.next(e)) {
+      ChannelStats& s = channels[e.channel];
+      if (s.count++ == 0) {
+        s.first = e.timestamp;
+        s.type = adit::msg::messageTypeName(e.data.data(), e.data.size());
+      }
+      s.last = e.timestamp;
+      s.bytes += static_cast<std::int64_t>(e.data.size());
+    }
+    fmt::print("{:<24} {:>8} {:<16} {:>10} {:>9} {:>10}\n", "channel", "messages", "type", "span_s", "rate_hz", "MB");
+    for (const auto& [name, s] : channels) {
+      const double span = static_cast<double>(s.last - s.first) * 1e-6;
+      fmt::print("{:<24} {:>8} {:<16} {:>10.3f} {:>9.2f} {:>10.2f}\n", name, s.count, s.type.empty() ? "?" : s.type,
+                 span, span > 0 ? static_cast<double>(s.count - 1) / span : 0.0, static_cast<double>(s.bytes) / 1e6);
+    }
+    if (reader.corruptFrames() || reader.truncated())
+      fmt::print("corrupt frames skipped: {}{}\n", reader.corruptFrames(), reader.truncated() ? ", truncated at the end" : "");
+  });
+}
