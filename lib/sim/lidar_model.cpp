@@ -10,6 +10,7 @@
 namespace adit::sim {
 namespace {
 constexpr double kDeg = M_PI / 180.0;
+constexpr int kPoseStride = 8;  // firing sequences between exact pose evaluations (0.44 ms for a VLP-16)
 }
 
 std::vector<std::uint16_t> LidarProfile::rings() const {
@@ -91,6 +92,12 @@ double LidarSimulator::firingOffset(int column, int channel) const {
 
 LidarScan LidarSimulator::simulate(const Scene& scene, const PoseAt& pose_at, double t_end, std::int64_t utime,
                                    std::int64_t seq, std::uint64_t seed) const {
+  LocalRayCaster caster(scene);
+  return simulate(caster, pose_at, t_end, utime, seq, seed);
+}
+
+LidarScan LidarSimulator::simulate(LocalRayCaster& caster, const PoseAt& pose_at, double t_end, std::int64_t utime,
+                                   std::int64_t seq, std::uint64_t seed) const {
   const int C = profile_.columns, J = profile_.channels();
   LidarScan scan;
   scan.utime = utime;
@@ -107,39 +114,53 @@ LidarScan LidarSimulator::simulate(const Scene& scene, const PoseAt& pose_at, do
   const float sigma = static_cast<float>(profile_.range_sigma);
   const float min_range = static_cast<float>(profile_.min_range), max_range = static_cast<float>(profile_.max_range);
   const float sin_grazing = static_cast<float>(std::sin(10.0 * kDeg));
-  const float slot_fraction = static_cast<float>(profile_.firing_slot / profile_.columnPeriod());
+  const double period = profile_.columnPeriod(), span = kPoseStride * period;
+  std::vector<float> channel_dt(J);
+  for (int j = 0; j < J; ++j) channel_dt[j] = static_cast<float>(firingOffset(C - 1, j));
+  std::vector<float> noise(J + 1);
 
-  Eigen::Isometry3d next = pose_at(t_end + firingOffset(0, 0));
+  caster.moveTo(pose_at(t_end).translation().cast<float>());
+  const double t_first = t_end + firingOffset(0, 0);
+  Eigen::Isometry3d pose_b = pose_at(t_first);
+  Eigen::Matrix3f Ra = Eigen::Matrix3f::Identity();
+  Eigen::Vector3f pa = Eigen::Vector3f::Zero(), dp = Eigen::Vector3f::Zero(), phi = Eigen::Vector3f::Zero();
   for (int c = 0; c < C; ++c) {
-    const Eigen::Isometry3d current = next;
-    next = pose_at(t_end + firingOffset(c, 0) + profile_.columnPeriod());
-    const Eigen::Matrix3f R = current.linear().cast<float>();
-    const Eigen::Vector3f p0 = current.translation().cast<float>();
-    const Eigen::Vector3f dp = (next.translation() - current.translation()).cast<float>();
-    const Eigen::Matrix3d dR = current.linear().transpose() * next.linear();
-    // Small rotation over one column (first order; the angle is < 1e-4 rad).
-    const Eigen::Vector3f phi =
-        0.5 * Eigen::Vector3d(dR(2, 1) - dR(1, 2), dR(0, 2) - dR(2, 0), dR(1, 0) - dR(0, 1)).cast<float>();
-
+    if (c % kPoseStride == 0) {
+      // Exact poses at the ends of the next kPoseStride columns; first-order interpolation in between.
+      const Eigen::Isometry3d pose_a = pose_b;
+      pose_b = pose_at(t_first + (c + kPoseStride) * period);
+      Ra = pose_a.linear().cast<float>();
+      pa = pose_a.translation().cast<float>();
+      dp = (pose_b.translation() - pose_a.translation()).cast<float>();
+      const Eigen::Matrix3d dR = pose_a.linear().transpose() * pose_b.linear();
+      phi = 0.5 * Eigen::Vector3d(dR(2, 1) - dR(1, 2), dR(0, 2) - dR(2, 0), dR(1, 0) - dR(0, 1)).cast<float>();
+    }
+    // Range noise for the whole sequence: Box-Muller pairs (a fixed number of draws per column).
+    for (int j = 0; j < J; j += 2) {
+      const double r = std::sqrt(-2.0 * std::log(1.0 - rng.uniform())), a = 2.0 * M_PI * rng.uniform();
+      noise[j] = static_cast<float>(r * std::cos(a));
+      noise[j + 1] = static_cast<float>(r * std::sin(a));
+    }
+    const float column_dt = static_cast<float>((c - (C - 1)) * period);
+    const float column_sigma = static_cast<float>((c % kPoseStride) * period / span);
     for (int j = 0; j < J; ++j) {
       const Eigen::Vector3f& d = directions_[static_cast<std::size_t>(c) * J + j];
-      const float s = j * slot_fraction;
+      const float s = column_sigma + static_cast<float>(j * profile_.firing_slot / span);
       Ray ray;
-      ray.origin = p0 + s * dp;
-      ray.dir = (R * (d + s * phi.cross(d))).normalized();
+      ray.origin = pa + s * dp;
+      ray.dir = Ra * (d + s * phi.cross(d));  // unit to ~1e-9: the rotation step is tiny
       ray.t_max = max_range;
-      // Fixed number of draws per firing, so the noise of a firing does not depend on what it hit.
-      const float n = static_cast<float>(rng.normal());
-      const double u_drop = rng.uniform(), u_dust = rng.uniform(), u_dust_range = rng.uniform();
-      const float u_intensity = static_cast<float>(rng.uniform());
+      // One 64-bit draw gives four 16-bit uniforms: dropout, dust, dust range, intensity jitter.
+      const std::uint64_t bits = rng.next();
+      auto u16 = [bits](int k) { return (static_cast<float>((bits >> (16 * k)) & 0xFFFF) + 0.5f) * (1.0f / 65536.0f); };
 
-      const Hit hit = scene.intersect(ray);
+      const Hit hit = caster.intersect(ray);
       float range = 0.0f, intensity = 0.0f;
-      if (!noise_.noiseless && noise_.dust && u_dust < noise_.dust_probability) {
-        const float r_dust = min_range + static_cast<float>(-noise_.dust_mean_range * std::log(1.0 - u_dust_range));
+      if (!noise_.noiseless && noise_.dust && u16(1) < noise_.dust_probability) {
+        const float r_dust = min_range - static_cast<float>(noise_.dust_mean_range) * std::log(1.0f - u16(2));
         if (!hit.valid() || r_dust < hit.t) {
           range = r_dust;
-          intensity = 2.0f + 6.0f * u_intensity;
+          intensity = 2.0f + 6.0f * u16(3);
         }
       }
       if (range == 0.0f) {
@@ -148,20 +169,20 @@ LidarScan LidarSimulator::simulate(const Scene& scene, const PoseAt& pose_at, do
         if (!noise_.noiseless) {
           const float grazing = std::max(0.0f, 1.0f - cos_incidence / sin_grazing);
           const float far = hit.t / max_range;
-          const double p_drop = noise_.dropout + noise_.grazing_dropout * grazing +
-                                noise_.dark_dropout * (1.0f - hit.reflectivity) * far * far;
-          if (u_drop < p_drop) continue;
+          const float p_drop = static_cast<float>(noise_.dropout + noise_.grazing_dropout * grazing +
+                                                  noise_.dark_dropout * (1.0f - hit.reflectivity) * far * far);
+          if (u16(0) < p_drop) continue;
         }
-        range = noise_.noiseless ? hit.t : hit.t + sigma * n;
+        range = noise_.noiseless ? hit.t : hit.t + sigma * noise[j];
         intensity = 255.0f * hit.reflectivity * (0.35f + 0.65f * cos_incidence) +
-                    (noise_.noiseless ? 0.0f : 6.0f * (u_intensity - 0.5f));
+                    (noise_.noiseless ? 0.0f : 6.0f * (u16(3) - 0.5f));
       }
       if (range < min_range || range > max_range) continue;
       LidarPoint pt;
       pt.p = range * d;
       pt.intensity = std::clamp(intensity, 0.0f, 255.0f);
       pt.ring = rings_[j];
-      pt.dt = static_cast<float>(firingOffset(c, j));
+      pt.dt = column_dt + channel_dt[j];
       scan.points.push_back(pt);
     }
   }

@@ -9,8 +9,12 @@
 // (not deskewed), in firing order, with ring = elevation rank (0 = lowest beam). No return (nothing within
 // max_range, dropout) gives no point, like an unorganised driver cloud.
 //
-// Pose sampling: the pose is evaluated exactly at every column start; inside a column (< 56 us) it is
-// interpolated to first order (error < 1e-8 m for these motions).
+// Pose sampling: the pose is evaluated exactly every 8 firing sequences (0.44 ms for a VLP-16) and interpolated
+// to first order for each firing in between (translation linear, rotation R_a (I + s [phi]x)): the error is
+// second order in the motion over 0.44 ms, below 1e-6 m at 100 m range for these robots, so every firing
+// effectively uses the pose at its own time.
+// Noise per sweep comes from its own stream with a fixed number of draws per firing sequence, so the k-th sweep
+// re-simulated with another pose function (e.g. frozen) gets the same noise, firing for firing.
 #pragma once
 
 #include "core/config.hpp"
@@ -78,6 +82,10 @@ class LidarSimulator {
   // identical noise (e.g. with a different pose function).
   LidarScan simulate(const Scene& scene, const PoseAt& pose_at, double t_end, std::int64_t utime, std::int64_t seq,
                      std::uint64_t seed) const;
+  // Same, reusing a caster's crop of the scene between sweeps (much faster for a stream of sweeps; the result
+  // is identical to the overload above up to ties between coincident surfaces).
+  LidarScan simulate(LocalRayCaster& caster, const PoseAt& pose_at, double t_end, std::int64_t utime,
+                     std::int64_t seq, std::uint64_t seed) const;
 
   const LidarProfile& profile() const { return profile_; }
   // Firing time of (column, channel) relative to the sweep's last firing (s, <= 0).

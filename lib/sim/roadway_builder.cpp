@@ -9,10 +9,10 @@ namespace {
 // Reflectivities (0..1): coal is dark, steel and painted pipes brighter, bolt plates and equipment brightest.
 constexpr float kCoal = 0.12f, kFloor = 0.2f, kSteel = 0.35f, kPlate = 0.5f, kPipe = 0.45f, kCable = 0.08f,
                 kEquipment = 0.6f;
-constexpr double kCellLength = 0.5;  // shell tessellation along a roadway (m)
-constexpr int kFloorCells = 6;       // floor tessellation across a roadway
-constexpr int kWallRows = 4;         // wall tessellation in height
-constexpr int kArchSegments = 8;     // roof tessellation across
+constexpr double kCellLength = 0.75; // shell tessellation along a roadway (m)
+constexpr int kFloorCells = 4;       // floor tessellation across a roadway
+constexpr int kWallRows = 3;         // wall tessellation in height
+constexpr int kArchSegments = 6;     // roof tessellation across
 constexpr double kTaper = 1.0;       // relief fades to zero within this distance of roadway ends and openings (m)
 
 double smoothstep(double x) {

@@ -5,6 +5,10 @@
 #include <cmath>
 #include <numeric>
 
+#if defined(__SSE2__)
+#include <xmmintrin.h>
+#endif
+
 namespace adit::sim {
 namespace {
 
@@ -24,21 +28,17 @@ Eigen::Vector3f safeInverse(const Eigen::Vector3f& d) {
   return inv;
 }
 
-bool hitTriangle(const Triangle& tri, const Ray& ray, float t_min, float& t, Eigen::Vector3f& normal) {
-  const Eigen::Vector3f p = ray.dir.cross(tri.e2);
-  const float det = tri.e1.dot(p);
-  if (std::fabs(det) < 1e-12f) return false;
-  const float inv = 1.0f / det;
-  const Eigen::Vector3f s = ray.origin - tri.a;
-  const float u = s.dot(p) * inv;
-  if (u < 0.0f || u > 1.0f) return false;
-  const Eigen::Vector3f q = s.cross(tri.e1);
-  const float v = ray.dir.dot(q) * inv;
-  if (v < 0.0f || u + v > 1.0f) return false;
-  const float th = tri.e2.dot(q) * inv;
-  if (th <= t_min || th >= t) return false;
+template <class TriangleTest>
+bool hitTriangle(const TriangleTest& tri, const Ray& ray, float t_min, float& t, Eigen::Vector3f& normal) {
+  const float denom = tri.normal.dot(ray.dir);
+  if (std::fabs(denom) < 1e-12f) return false;
+  const float th = tri.normal.dot(tri.a - ray.origin) / denom;
+  if (!(th > t_min && th < t)) return false;
+  const Eigen::Vector3f q = ray.origin + th * ray.dir - tri.a;
+  const float u = q.dot(tri.bu), v = q.dot(tri.bv);
+  if (u < 0.0f || v < 0.0f || u + v > 1.0f) return false;
   t = th;
-  normal = tri.e1.cross(tri.e2).normalized();
+  normal = tri.normal;
   return true;
 }
 
@@ -159,7 +159,7 @@ Eigen::AlignedBox3f Scene::refBounds(const Ref& r) const {
 bool Scene::intersectRef(const Ref& r, const Ray& ray, float t_min, Hit& hit) const {
   bool found = false;
   switch (r.shape) {
-    case Shape::Triangle: found = hitTriangle(triangles_[r.index], ray, t_min, hit.t, hit.normal); break;
+    case Shape::Triangle: found = hitTriangle(triangle_tests_[r.index], ray, t_min, hit.t, hit.normal); break;
     case Shape::Box: found = hitBox(boxes_[r.index], ray, t_min, hit.t, hit.normal); break;
     case Shape::Cylinder: found = hitCylinder(cylinders_[r.index], ray, t_min, hit.t, hit.normal); break;
   }
@@ -178,6 +178,89 @@ void Scene::build() {
   }
   nodes_.reserve(2 * refs_.size() / kMaxLeafSize + 1);
   buildNode(boxes, centroids, 0, static_cast<int>(refs_.size()));
+  bounds_ = Eigen::AlignedBox3f(Eigen::Vector3f(nodes_[0].lo[0], nodes_[0].lo[1], nodes_[0].lo[2]),
+                                Eigen::Vector3f(nodes_[0].hi[0], nodes_[0].hi[1], nodes_[0].hi[2]));
+  // Store primitives in leaf order so a leaf's data is contiguous in memory.
+  std::vector<Triangle> triangles;
+  std::vector<OrientedBox> boxes_sorted;
+  std::vector<Cylinder> cylinders;
+  triangles.reserve(triangles_.size());
+  boxes_sorted.reserve(boxes_.size());
+  cylinders.reserve(cylinders_.size());
+  for (Ref& r : refs_) {
+    switch (r.shape) {
+      case Shape::Triangle: triangles.push_back(triangles_[r.index]); r.index = static_cast<std::uint32_t>(triangles.size() - 1); break;
+      case Shape::Box: boxes_sorted.push_back(boxes_[r.index]); r.index = static_cast<std::uint32_t>(boxes_sorted.size() - 1); break;
+      case Shape::Cylinder: cylinders.push_back(cylinders_[r.index]); r.index = static_cast<std::uint32_t>(cylinders.size() - 1); break;
+    }
+  }
+  triangles_.swap(triangles);
+  triangle_tests_.clear();
+  triangle_tests_.reserve(triangles_.size());
+  for (const Triangle& t : triangles_) {
+    const Eigen::Vector3f n = t.e1.cross(t.e2);
+    const float n2 = n.squaredNorm();
+    triangle_tests_.push_back({t.a, n / std::sqrt(n2), t.e2.cross(n) / n2, n.cross(t.e1) / n2});
+  }
+  boxes_.swap(boxes_sorted);
+  cylinders_.swap(cylinders);
+  nodes4_.clear();
+  nodes4_.reserve(nodes_.size() / 2 + 1);
+  collapse(0);
+  nodes_.clear();
+  nodes_.shrink_to_fit();
+}
+
+// Collapses the binary subtree at `binary_node` into 4-wide nodes: a node's children are replaced by their own
+// children, largest box first, until it has 4. Unused slots get an empty box far away that no ray can enter.
+int Scene::collapse(int binary_node) {
+  const int index = static_cast<int>(nodes4_.size());
+  nodes4_.push_back(Node4{});
+  std::vector<int> kids;
+  if (nodes_[binary_node].count > 0) {
+    kids = {binary_node};
+  } else {
+    kids = {binary_node + 1, nodes_[binary_node].first_or_right};
+    while (kids.size() < 4) {
+      int best = -1;
+      float best_area = -1.0f;
+      for (int k = 0; k < static_cast<int>(kids.size()); ++k) {
+        const Node& n = nodes_[kids[k]];
+        if (n.count > 0) continue;
+        const Eigen::AlignedBox3f b(Eigen::Vector3f(n.lo[0], n.lo[1], n.lo[2]), Eigen::Vector3f(n.hi[0], n.hi[1], n.hi[2]));
+        if (area(b) > best_area) {
+          best_area = area(b);
+          best = k;
+        }
+      }
+      if (best < 0) break;
+      const int split = kids[best];
+      kids.erase(kids.begin() + best);
+      kids.push_back(split + 1);
+      kids.push_back(nodes_[split].first_or_right);
+    }
+  }
+  for (int k = 0; k < 4; ++k) {
+    const bool used = k < static_cast<int>(kids.size());
+    int child = -1, count = 0;
+    if (used) {
+      const Node& n = nodes_[kids[k]];
+      if (n.count > 0) {
+        child = ~n.first_or_right;
+        count = n.count;
+      } else {
+        child = collapse(kids[k]);  // may reallocate nodes4_: write through the index below
+      }
+    }
+    Node4& out = nodes4_[index];
+    for (int a = 0; a < 3; ++a) {
+      out.lo[a][k] = used ? nodes_[kids[k]].lo[a] : 1e30f;
+      out.hi[a][k] = used ? nodes_[kids[k]].hi[a] : 1e30f;
+    }
+    out.child[k] = child;
+    out.count[k] = count;
+  }
+  return index;
 }
 
 // Recursive binned-SAH build over refs_[first, first+count); boxes/centroids are permuted along with refs_.
@@ -266,50 +349,73 @@ int Scene::buildNode(std::vector<Eigen::AlignedBox3f>& boxes, std::vector<Eigen:
 Hit Scene::intersect(const Ray& ray, float t_min) const {
   Hit hit;
   hit.t = ray.t_max;
-  if (nodes_.empty()) return Hit{};
+  if (nodes4_.empty()) return Hit{};
+  // Slab test as t = bound * inv - origin * inv, four child boxes at once.
   const Eigen::Vector3f inv = safeInverse(ray.dir);
-  const Eigen::Vector3f o = ray.origin;
-  // Entry distance into a node's box, or +inf if the ray misses it before the current best hit.
-  auto entry = [&](const Node& n) {
-    float t0 = t_min, t1 = hit.t;
-    for (int k = 0; k < 3; ++k) {
-      float a = (n.lo[k] - o[k]) * inv[k], b = (n.hi[k] - o[k]) * inv[k];
-      if (a > b) std::swap(a, b);
-      t0 = a > t0 ? a : t0;
-      t1 = b < t1 ? b : t1;
-    }
-    return t0 <= t1 ? t0 : std::numeric_limits<float>::infinity();
-  };
+  const float oi[3] = {ray.origin.x() * inv.x(), ray.origin.y() * inv.y(), ray.origin.z() * inv.z()};
   struct Pending {
-    int node;
+    std::int32_t child, count;
     float t;
   };
-  Pending stack[64];
+  Pending stack[128];
   int sp = 0;
-  int node = entry(nodes_[0]) < std::numeric_limits<float>::infinity() ? 0 : -1;
-  while (node >= 0) {
-    const Node& n = nodes_[node];
-    if (n.count > 0) {
-      for (int i = n.first_or_right; i < n.first_or_right + n.count; ++i)
+  Pending cur{0, 0, t_min};
+  alignas(16) float t_enter[4];
+  for (;;) {
+    if (cur.child < 0) {  // leaf
+      const int first = ~cur.child;
+      for (int i = first; i < first + cur.count; ++i)
         if (intersectRef(refs_[i], ray, t_min, hit)) hit.primitive = i;
-      node = -1;
     } else {
-      int near = node + 1, far = n.first_or_right;
-      float t_near = entry(nodes_[near]), t_far = entry(nodes_[far]);
-      if (t_far < t_near) {
-        std::swap(near, far);
-        std::swap(t_near, t_far);
+      const Node4& n = nodes4_[cur.child];
+      int mask = 0;
+#if defined(__SSE2__)
+      __m128 near = _mm_set1_ps(t_min), far = _mm_set1_ps(hit.t);
+      for (int a = 0; a < 3; ++a) {
+        const __m128 i4 = _mm_set1_ps(inv[a]), o4 = _mm_set1_ps(oi[a]);
+        const __m128 t0 = _mm_sub_ps(_mm_mul_ps(_mm_load_ps(n.lo[a]), i4), o4);
+        const __m128 t1 = _mm_sub_ps(_mm_mul_ps(_mm_load_ps(n.hi[a]), i4), o4);
+        near = _mm_max_ps(near, _mm_min_ps(t0, t1));
+        far = _mm_min_ps(far, _mm_max_ps(t0, t1));
       }
-      if (t_far < std::numeric_limits<float>::infinity() && sp < 64) stack[sp++] = {far, t_far};
-      node = t_near < std::numeric_limits<float>::infinity() ? near : -1;
+      mask = _mm_movemask_ps(_mm_cmple_ps(near, far));
+      _mm_store_ps(t_enter, near);
+#else
+      for (int k = 0; k < 4; ++k) {
+        float near = t_min, far = hit.t;
+        for (int a = 0; a < 3; ++a) {
+          const float t0 = n.lo[a][k] * inv[a] - oi[a], t1 = n.hi[a][k] * inv[a] - oi[a];
+          near = std::max(near, std::min(t0, t1));
+          far = std::min(far, std::max(t0, t1));
+        }
+        t_enter[k] = near;
+        if (near <= far) mask |= 1 << k;
+      }
+#endif
+      if (mask != 0) {
+        // Continue with the nearest child; push the others, farthest first.
+        int order[4], m = 0;
+        for (int k = 0; k < 4; ++k) {
+          if (!(mask & (1 << k))) continue;
+          int j = m++;
+          while (j > 0 && t_enter[order[j - 1]] < t_enter[k]) {
+            order[j] = order[j - 1];
+            --j;
+          }
+          order[j] = k;
+        }
+        for (int j = 0; j + 1 < m && sp < 128; ++j) stack[sp++] = {n.child[order[j]], n.count[order[j]], t_enter[order[j]]};
+        const int k = order[m - 1];
+        cur = {n.child[k], n.count[k], t_enter[k]};
+        continue;
+      }
     }
-    while (node < 0 && sp > 0) {
-      const Pending p = stack[--sp];
-      if (p.t <= hit.t) node = p.node;
-    }
+    // Next pending node that can still hold a nearer hit.
+    do {
+      if (sp == 0) return hit.primitive < 0 ? Hit{} : hit;
+      cur = stack[--sp];
+    } while (cur.t > hit.t);
   }
-  if (hit.primitive < 0) return Hit{};
-  return hit;
 }
 
 Hit Scene::intersectBruteForce(const Ray& ray, float t_min) const {
@@ -321,13 +427,48 @@ Hit Scene::intersectBruteForce(const Ray& ray, float t_min) const {
   return hit;
 }
 
-Eigen::AlignedBox3f Scene::bounds() const {
-  Eigen::AlignedBox3f b;
-  if (!nodes_.empty()) {
-    b.extend(Eigen::Vector3f(nodes_[0].lo[0], nodes_[0].lo[1], nodes_[0].lo[2]));
-    b.extend(Eigen::Vector3f(nodes_[0].hi[0], nodes_[0].hi[1], nodes_[0].hi[2]));
+Eigen::AlignedBox3f Scene::bounds() const { return bounds_; }
+
+Scene Scene::crop(const Eigen::AlignedBox3f& region) const {
+  Scene out;
+  for (const Ref& r : refs_) {
+    if (!refBounds(r).intersects(region)) continue;
+    Ref copy = r;
+    switch (r.shape) {
+      case Shape::Triangle: copy.index = static_cast<std::uint32_t>(out.triangles_.size()); out.triangles_.push_back(triangles_[r.index]); break;
+      case Shape::Box: copy.index = static_cast<std::uint32_t>(out.boxes_.size()); out.boxes_.push_back(boxes_[r.index]); break;
+      case Shape::Cylinder: copy.index = static_cast<std::uint32_t>(out.cylinders_.size()); out.cylinders_.push_back(cylinders_[r.index]); break;
+    }
+    out.refs_.push_back(copy);
   }
-  return b;
+  out.build();
+  return out;
+}
+
+void LocalRayCaster::moveTo(const Eigen::Vector3f& position) {
+  const Eigen::Vector3i key = (position / cell_).array().floor().cast<int>();
+  if (key == key_) return;
+  key_ = key;
+  const Eigen::Vector3f centre = (key.cast<float>().array() + 0.5f) * cell_;
+  region_ = Eigen::AlignedBox3f(centre - Eigen::Vector3f::Constant(half_size_), centre + Eigen::Vector3f::Constant(half_size_));
+  local_ = scene_->crop(region_);
+}
+
+Hit LocalRayCaster::intersect(const Ray& ray, float t_min) const {
+  if (!region_.contains(ray.origin)) return scene_->intersect(ray, t_min);
+  // Distance at which the ray leaves the crop region.
+  float t_exit = std::numeric_limits<float>::infinity();
+  for (int a = 0; a < 3; ++a) {
+    if (ray.dir[a] > 0.0f) t_exit = std::min(t_exit, (region_.max()[a] - ray.origin[a]) / ray.dir[a]);
+    if (ray.dir[a] < 0.0f) t_exit = std::min(t_exit, (region_.min()[a] - ray.origin[a]) / ray.dir[a]);
+  }
+  Ray local_ray = ray;
+  local_ray.t_max = std::min(ray.t_max, t_exit);
+  const Hit hit = local_.intersect(local_ray, t_min);
+  // A hit inside the region is the nearest: anything nearer lies in the region, hence in the crop.
+  if (hit.valid() || t_exit >= ray.t_max) return hit;
+  // Nothing before the exit: only hits beyond it remain (a small overlap guards against rounding).
+  return scene_->intersect(ray, std::max(t_min, t_exit - 1e-3f));
 }
 
 }  // namespace adit::sim

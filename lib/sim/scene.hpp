@@ -21,7 +21,7 @@ struct Hit {
   float t = std::numeric_limits<float>::infinity();  // distance along the ray (m)
   Eigen::Vector3f normal = Eigen::Vector3f::Zero();    // unit surface normal (either side)
   float reflectivity = 0.0f;                           // 0..1, drives lidar intensity and dropouts
-  int primitive = -1;                                  // index into the scene, -1 = no hit
+  int primitive = -1;                                  // primitive index in the answering scene, -1 = no hit
   bool valid() const { return primitive >= 0; }
 };
 
@@ -55,7 +55,8 @@ class Scene {
   // Cylinder between two points; degenerate ones (zero length or radius) are ignored.
   void addCylinder(const Eigen::Vector3f& p0, const Eigen::Vector3f& p1, float radius, float reflectivity);
 
-  // Builds the BVH (binned SAH). Must be called after the last add and before intersect().
+  // Builds the BVH (binned SAH, collapsed to 4-wide nodes tested with SIMD). Must be called after the last add
+  // and before intersect().
   void build();
 
   // Nearest hit with t in (t_min, ray.t_max]; invalid Hit if none.
@@ -63,8 +64,11 @@ class Scene {
   // Same, by testing every primitive: the reference the BVH is tested against.
   Hit intersectBruteForce(const Ray& ray, float t_min = 1e-4f) const;
 
+  // A new, built scene with every primitive whose bounds touch `region` (same primitives, same order).
+  Scene crop(const Eigen::AlignedBox3f& region) const;
+
   std::size_t size() const { return refs_.size(); }
-  std::size_t numNodes() const { return nodes_.size(); }
+  std::size_t numNodes() const { return nodes4_.size(); }
   Eigen::AlignedBox3f bounds() const;
 
   // Read access for surface sampling (world point cloud) and tests.
@@ -85,15 +89,53 @@ class Scene {
     std::int32_t count;
   };
 
+  struct alignas(16) Node4 {  // 4-wide node, boxes as structure of arrays; child < 0: leaf ~child, count
+    float lo[3][4];
+    float hi[3][4];
+    std::int32_t child[4];
+    std::int32_t count[4];
+  };
+
+  // Triangle in the form the intersection test wants: plane first (cheap rejection by distance), then
+  // barycentrics as two dot products.
+  struct TriangleTest {
+    Eigen::Vector3f a, normal, bu, bv;  // normal unit; u = (p - a).bu, v = (p - a).bv
+  };
+
   Eigen::AlignedBox3f refBounds(const Ref& r) const;
+  int collapse(int binary_node);
   bool intersectRef(const Ref& r, const Ray& ray, float t_min, Hit& hit) const;
   int buildNode(std::vector<Eigen::AlignedBox3f>& boxes, std::vector<Eigen::Vector3f>& centroids, int first, int count);
 
   std::vector<Triangle> triangles_;
+  std::vector<TriangleTest> triangle_tests_;  // parallel to triangles_, filled by build()
   std::vector<OrientedBox> boxes_;
   std::vector<Cylinder> cylinders_;
   std::vector<Ref> refs_;
-  std::vector<Node> nodes_;
+  std::vector<Node> nodes_;    // binary BVH (build only)
+  std::vector<Node4> nodes4_;  // what intersect() traverses
+  Eigen::AlignedBox3f bounds_;
+};
+
+// Exact nearest-hit queries for rays that start near one place (a lidar during a sweep): a cropped copy of the
+// scene around a cell answers the many short rays cheaply; rays leaving the crop fall back to the whole scene.
+// The crop depends only on the cell of the query position (cells of `cell` metres), never on the query history,
+// so results are a pure function of the inputs.
+class LocalRayCaster {
+ public:
+  explicit LocalRayCaster(const Scene& scene, float half_size = 8.0f, float cell = 2.0f)
+      : scene_(&scene), half_size_(half_size), cell_(cell) {}
+  // Selects the crop for rays starting near `position` (rebuilds it if the cell changed).
+  void moveTo(const Eigen::Vector3f& position);
+  // Same answer as Scene::intersect on the whole scene (up to exact ties between coincident surfaces).
+  Hit intersect(const Ray& ray, float t_min = 1e-4f) const;
+
+ private:
+  const Scene* scene_;
+  float half_size_, cell_;
+  Eigen::Vector3i key_ = Eigen::Vector3i::Constant(std::numeric_limits<int>::min());
+  Eigen::AlignedBox3f region_;
+  Scene local_;
 };
 
 }  // namespace adit::sim

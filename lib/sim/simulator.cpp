@@ -33,6 +33,7 @@ Simulator::Simulator(const SimConfig& config)
       world_(std::make_unique<World>(buildWorld(resolveWorld(config)))),
       motion_(planMotion(*world_, config.motion, config.duration_s, config.seed)),
       lidar_(lidarProfile(config.sensor), config.lidar),
+      caster_(world_->scene),
       imu_(config.imu, config.seed) {
   if (!(config.duration_s >= 0.0) || !(config.imu.rate_hz > 0.0))
     throw std::invalid_argument("sim: duration must be >= 0 and imu rate > 0");
@@ -49,9 +50,9 @@ LidarScan Simulator::simulateSweep(std::int64_t seq, bool frozen) const {
   const BSplineTrajectory& traj = motion_.trajectory;
   if (frozen || config_.freeze_sweep_motion) {
     const Eigen::Isometry3d fixed = traj.pose(t_end);
-    return lidar_.simulate(world_->scene, [&](double) { return fixed; }, t_end, utime, seq, config_.seed);
+    return lidar_.simulate(caster_, [&](double) { return fixed; }, t_end, utime, seq, config_.seed);
   }
-  return lidar_.simulate(world_->scene, [&](double t) { return traj.pose(t); }, t_end, utime, seq, config_.seed);
+  return lidar_.simulate(caster_, [&](double t) { return traj.pose(t); }, t_end, utime, seq, config_.seed);
 }
 
 StampedPose Simulator::groundTruth(std::int64_t utime) const {

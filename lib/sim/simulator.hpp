@@ -70,6 +70,7 @@ class Simulator {
   bool next(SimEvent& event);
 
   // Random access to sweep `seq` (0-based), identical to the stream's; `frozen` = no motion within the sweep.
+  // Not thread-safe (it updates the ray caster's crop of the world).
   LidarScan simulateSweep(std::int64_t seq, bool frozen = false) const;
   std::int64_t sweepUtime(std::int64_t seq) const;
   std::int64_t numSweeps() const { return num_sweeps_; }
@@ -98,6 +99,7 @@ class Simulator {
   std::unique_ptr<World> world_;
   PlannedMotion motion_;
   LidarSimulator lidar_;
+  mutable LocalRayCaster caster_;  // crop of the world around the sensor; a cache, results do not depend on it
   ImuSimulator imu_;
   std::int64_t sweep_period_us_ = 100000;
   std::int64_t num_sweeps_ = 0, num_imu_ = 0;

@@ -156,9 +156,9 @@ World buildWorld(const WorldConfig& config) {
   World w;
   w.config = config;
   Rng rng = Rng::forStream(config.seed, Stream::World);
-  w.floor_relief = WaveField(rng, 24, 0.8, 12.0, config.floor_roughness, true);
+  w.floor_relief = WaveField(rng, 24, 1.5, 12.0, config.floor_roughness, true);
   w.grade = WaveField(rng, 3, 150.0, 400.0, config.grade_amplitude / std::sqrt(2.0), true);
-  w.wall_relief = WaveField(rng, 24, 0.7, 6.0, config.wall_roughness, false);
+  w.wall_relief = WaveField(rng, 24, 1.5, 6.0, config.wall_roughness, false);
   if (config.name == "roadway-loop") {
     layoutLoop(w, rng);
   } else if (config.name == "room-and-pillar") {
