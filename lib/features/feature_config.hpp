@@ -75,8 +75,9 @@ struct LoamConfig {
   // features.loam.sectors: each ring is split into this many equal sectors, features picked per sector
   // so they spread around the sweep (A-LOAM: 6).
   int sectors = 6;
-  // Smoothness is dimensionless: |sum_j (p_j - p_i)| / sum_j |p_j - p_i|. It is 0 on a straight scan line,
-  // cos(a/2) at a corner of interior angle a (0.71 at 90 deg), and does not depend on range or resolution.
+  // Smoothness is dimensionless (see smoothness.hpp): |sum_j (p_j - p_i)| over the neighbours' path length
+  // from p_i. It is 0 on a straight scan line, cos(a/2) at a corner of interior angle a (0.71 at 90 deg),
+  // and does not depend on range or angular resolution.
   // features.loam.edge_threshold: above this a point may be sharp / less sharp (a 140 deg bend is 0.34).
   float edge_threshold = 0.3f;
   // features.loam.surf_threshold: below this a point may be flat (a 170 deg bend is 0.09).
@@ -119,12 +120,13 @@ struct LinK3dConfig {
   // features.link3d.sectors: horizontal sectors the edge points are grouped into (paper eq. 2: 120).
   int sectors = 120;
   // features.link3d.cluster_radial_tol / cluster_xy_tol (m): a point joins a cluster of its sector if its
-  // horizontal range differs from the cluster's mean by less than radial_tol and its x and y from the
-  // cluster's mean x and y by less than xy_tol (reference code: 0.4 / 0.3).
+  // horizontal range differs from the cluster's mean by less than radial_tol and its horizontal position
+  // lies within xy_tol of the cluster's mean (reference code: 0.4 / 0.3, but on |dx| and |dy| separately,
+  // which depends on the sensor's yaw).
   float cluster_radial_tol = 0.4f;
   float cluster_xy_tol = 0.3f;
   // features.link3d.merge_radial_tol / merge_xy_tol (m): clusters of the same or neighbouring sectors
-  // whose means agree this well are one object cut by a sector border (reference code: 0.6 / 0.8).
+  // whose means agree this well (same two tests) are one object cut by a sector border (reference: 0.6 / 0.8).
   float merge_radial_tol = 0.6f;
   float merge_xy_tol = 0.8f;
   // features.link3d.min_cluster_points / min_cluster_rings: a merged cluster becomes a keypoint only with
