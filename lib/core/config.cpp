@@ -46,14 +46,6 @@ Config Config::fromYamlFile(const std::string& path) {
   return c;
 }
 
-Config Config::section(const std::string& prefix) const {
-  Config c;
-  const std::string p = prefix + ".";
-  for (auto it = values_.lower_bound(p); it != values_.end() && it->first.compare(0, p.size(), p) == 0; ++it)
-    c.values_[it->first.substr(p.size())] = it->second;
-  return c;
-}
-
 void Config::merge(const Config& other) {
   for (const auto& kv : other.values_) values_[kv.first] = kv.second;
 }

@@ -17,9 +17,7 @@ class Config {
   static Config fromYamlFile(const std::string& path);
   static Config fromYamlString(const std::string& text);
 
-  // The keys under "prefix." with the prefix removed.
-  Config section(const std::string& prefix) const;
-  // Overlay: values of `other` replace ours.
+  // Overlay: values of `other` replace ours (a sensor file over the pipeline defaults).
   void merge(const Config& other);
 
   bool has(const std::string& key) const { return values_.count(key) > 0; }
@@ -30,17 +28,30 @@ class Config {
   template <class T>
   T get(const std::string& key, const T& fallback) const {
     auto it = values_.find(key);
-    if (it == values_.end()) return fallback;
-    return parse<T>(key, it->second);
+    const T value = it == values_.end() ? fallback : parse<T>(key, it->second);
+    if (reads_) (*reads_)[key] = format(value);
+    return value;
   }
   // A YAML sequence ("key: [1, 2, 3]") stored as key.0, key.1, ...
   template <class T>
   std::vector<T> getList(const std::string& key, const std::vector<T>& fallback) const {
-    if (!has(key + ".0")) return fallback;
-    std::vector<T> out;
-    for (int i = 0; has(key + "." + std::to_string(i)); ++i) out.push_back(get<T>(key + "." + std::to_string(i), T{}));
+    std::vector<T> out = fallback;
+    if (has(key + ".0")) {
+      out.clear();
+      for (int i = 0; has(key + "." + std::to_string(i)); ++i)
+        out.push_back(parse<T>(key, values_.at(key + "." + std::to_string(i))));
+    }
+    if (reads_) {
+      std::string text = "[";
+      for (std::size_t i = 0; i < out.size(); ++i) text += (i ? ", " : "") + format(out[i]);
+      (*reads_)[key] = text + "]";
+    }
     return out;
   }
+
+  // Record every key read through get()/getList() with the value it resolved to (the default when the key
+  // is absent), for `adit config --defaults` and the check that launch/config files name only real keys.
+  void recordReadsInto(std::map<std::string, std::string>* reads) const { reads_ = reads; }
 
  private:
   template <class T>
@@ -60,7 +71,20 @@ class Config {
       return value;
     }
   }
+  template <class T>
+  static std::string format(const T& value) {
+    if constexpr (std::is_same_v<T, std::string>) {
+      return value;
+    } else if constexpr (std::is_same_v<T, bool>) {
+      return value ? "true" : "false";
+    } else {
+      std::ostringstream out;
+      out << value;
+      return out.str();
+    }
+  }
   std::map<std::string, std::string> values_;
+  mutable std::map<std::string, std::string>* reads_ = nullptr;  // not owned; null = not recording
 };
 
 }  // namespace adit

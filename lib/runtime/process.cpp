@@ -60,13 +60,19 @@ std::int64_t wallUtime() {
 void addProcessOptions(CLI::App& app, ProcessOptions& o) {
   app.add_option("--lcm-url", o.lcm_url, "LCM provider to subscribe to (default: $LCM_DEFAULT_URL or udpm)");
   app.add_option("--out-url", o.out_url, "LCM provider to publish to (default: the --lcm-url one)");
-  app.add_option("--config", o.config_path, "YAML configuration (default: built-in defaults, see launch/config/)");
+  app.add_option("--config", o.config_paths,
+                 "YAML configuration, repeatable: later files override earlier ones (default: built-in defaults, "
+                 "which launch/config/pipeline.yaml lists)");
   app.add_option("--channel", o.channel_remaps, "Rename a channel: PORT=CHANNEL (repeatable)");
   app.add_option("--status-period", o.status_period_s, "Seconds between STATUS messages")->check(CLI::PositiveNumber);
   app.add_option("--status-channel", o.status_channel, "STATUS channel (default STATUS_<process>)");
 }
 
-Config loadConfig(const std::string& path) { return path.empty() ? Config{} : Config::fromYamlFile(path); }
+Config loadConfig(const std::vector<std::string>& paths) {
+  Config config;
+  for (const auto& path : paths) config.merge(Config::fromYamlFile(path));
+  return config;
+}
 
 void applyRemaps(Node& node, const std::vector<std::string>& remaps) {
   for (const auto& r : remaps) {
@@ -87,7 +93,7 @@ int runNodeProcess(int argc, char** argv, const std::string& name, const std::st
 
   std::unique_ptr<Node> node;
   try {
-    node = factory(loadConfig(options.config_path));
+    node = factory(loadConfig(options.config_paths));
     applyRemaps(*node, options.channel_remaps);
   } catch (const StageNotImplemented& e) {
     spdlog::error("{}", e.what());

@@ -24,7 +24,7 @@ struct StageNotImplemented : std::runtime_error {
 struct ProcessOptions {
   std::string lcm_url;  // subscribe (and publish) here; "" = $LCM_DEFAULT_URL or LCM's default
   std::string out_url;  // publish here instead, if set
-  std::string config_path;
+  std::vector<std::string> config_paths;  // merged in order: later files override earlier ones
   std::vector<std::string> channel_remaps;  // PORT=CHANNEL
   double status_period_s = 1.0;
   std::string status_channel;  // "" = STATUS_<NAME>
@@ -32,8 +32,8 @@ struct ProcessOptions {
 
 void addProcessOptions(CLI::App& app, ProcessOptions& options);
 
-// Reads --config (empty path = built-in defaults). Throws std::runtime_error with a clear message.
-Config loadConfig(const std::string& path);
+// Reads and merges --config files in order (none = built-in defaults). Throws std::runtime_error.
+Config loadConfig(const std::vector<std::string>& paths);
 
 // Applies PORT=CHANNEL remaps; throws std::runtime_error on a malformed one or an unknown port.
 void applyRemaps(Node& node, const std::vector<std::string>& remaps);

@@ -13,7 +13,8 @@
 namespace {
 
 struct ReplayArgs {
-  std::string log, out_dir, config;
+  std::string log, out_dir;
+  std::vector<std::string> configs;
   std::vector<std::string> stages;
   bool no_progress = false;
 };
@@ -35,14 +36,16 @@ void registerReplayCommand(CLI::App& app) {
   cmd->add_option("log", args->log, "Input LCM log (LIDAR_POINTS, IMU)")->required()->check(CLI::ExistingFile);
   cmd->add_option("-o,--out", args->out_dir, "Output folder (output.lcmlog, trajectory.tum, odometry.tum, map.pcd, timing.json)")
       ->required();
-  cmd->add_option("--config", args->config, "YAML configuration (default: built-in defaults = launch/config/pipeline.yaml)");
+  cmd->add_option("--config", args->configs,
+                  "YAML configuration, repeatable, later files override (default: built-in defaults, listed in "
+                  "launch/config/pipeline.yaml)");
   cmd->add_option("--stages", args->stages, "Only these stages (feature odometry mapper loop_closer)");
   cmd->add_flag("--no-progress", args->no_progress, "No progress bar even on a terminal");
   cmd->callback([args] {
     adit::pipeline::ReplayOptions options;
     options.input_log = args->log;
     options.out_dir = args->out_dir;
-    options.config = adit::runtime::loadConfig(args->config);
+    options.config = adit::runtime::loadConfig(args->configs);
     options.stages = args->stages;
     if (!args->no_progress && ::isatty(STDERR_FILENO)) options.on_progress = drawProgress;
     adit::runtime::installStopHandlers();

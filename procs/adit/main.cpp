@@ -18,6 +18,7 @@ int main(int argc, char** argv) {
   spdlog::set_pattern("%H:%M:%S.%e %^%l%$ adit: %v");
   registerImportCommand(app);
   registerInfoCommand(app);
+  registerConfigCommand(app);
   registerReplayCommand(app);
   registerLaunchCommand(app);
   registerSpyCommand(app);
