@@ -83,9 +83,11 @@ struct LoamConfig {
   // features.loam.surf_threshold: below this a point may be flat (a 170 deg bend is 0.09).
   float surf_threshold = 0.1f;
   // features.loam.edge_min_offset (m): an edge point must also lie this far from its neighbours' centroid
-  // (PointScores::offset). Range noise (1-2 cm on VLP-16 / HDL-64E) alone moves a point about its sigma;
-  // a 90 deg corner sits ~2 beam spacings off, so corners count from ~5 m on a VLP-16.
-  float edge_min_offset = 0.03f;
+  // (PointScores::offset). Range noise alone moves a point by about its sigma, and a sweep has tens of
+  // thousands of tries: set ~5 sigma (1 cm range noise, VLP-16 class: 0.05; with 0.03, as A-LOAM's
+  // threshold, most sharp picks in a noisy box room were noise). A 90 deg corner sits ~2 beam spacings
+  // off, so on a VLP-16 corners count from ~7 m; nearer, the noise hides them anyway.
+  float edge_min_offset = 0.05f;
   // features.loam.surf_max_offset (m): a point this close to its neighbours' centroid is flat whatever its
   // ratio: near the sensor the beam spacing is below the noise and the ratio only measures noise.
   float surf_max_offset = 0.01f;

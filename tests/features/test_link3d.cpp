@@ -142,23 +142,32 @@ TEST(LinK3d, RecoversAKnownYawAndTranslationOfTheSameCloud) {
 }
 
 TEST(LinK3d, RecoversTheMotionBetweenTwoSimulatedViewpoints) {
-  // A real second sweep (re-cast from a pose 1 m ahead, turned 8 deg): cluster centroids shift with the
-  // rings that see each pillar, so tolerances are looser than for the same cloud moved.
+  // A real second sweep (re-cast from a pose 1 m ahead, turned 8 deg), without and with 2 cm range noise:
+  // cluster centroids shift with the rings that see each pillar, so tolerances are looser than for the
+  // same cloud moved. Measured: 0.017 m / 0.04 deg noise-free, 0.026 m / 0.14 deg at 2 cm.
   const test::Scene hall = test::pillarHall();
   const Eigen::Isometry3d T_a_b_true = yawAndShift(8.0, {1.0, 0.3, 0.0});
   const FeatureExtractor fx{FeatureConfig{}};
-  const FeatureSet a = fx.process(test::scanScene(hall, Eigen::Isometry3d::Identity()), {}, MotionPrior{});
-  const FeatureSet b = fx.process(test::scanScene(hall, T_a_b_true), {}, MotionPrior{});
-  const auto matches = matchLinK3d(a, b, fx.config().link3d);
-  const RansacResult r = estimateTransformRansac(a.keypoints, b.keypoints, matches, fx.config().ransac);
-  ASSERT_TRUE(r.ok);
-  const Eigen::Isometry3d err = T_a_b_true.inverse() * r.T_a_b;
-  std::printf("two viewpoints: %zu / %zu keypoints, %zu matches, %zu inliers, error %.4f m %.4f deg\n",
-              a.keypoints.size(), b.keypoints.size(), matches.size(), r.inliers.size(), err.translation().norm(),
-              angleDeg(err));
-  EXPECT_LT(err.translation().norm(), 0.10);
-  EXPECT_LT(angleDeg(err), 0.5);
-  EXPECT_GE(r.inliers.size(), 10u);
+  for (float sigma : {0.0f, 0.02f}) {
+    std::mt19937 rng(5);
+    std::normal_distribution<float> noise(0.0f, 1.0f);
+    const auto noisy = [&](LidarScan scan) {
+      for (LidarPoint& p : scan.points) p.p *= 1.0f + sigma * noise(rng) / p.p.norm();
+      return scan;
+    };
+    const FeatureSet a = fx.process(noisy(test::scanScene(hall, Eigen::Isometry3d::Identity())), {}, MotionPrior{});
+    const FeatureSet b = fx.process(noisy(test::scanScene(hall, T_a_b_true)), {}, MotionPrior{});
+    const auto matches = matchLinK3d(a, b, fx.config().link3d);
+    const RansacResult r = estimateTransformRansac(a.keypoints, b.keypoints, matches, fx.config().ransac);
+    ASSERT_TRUE(r.ok) << sigma;
+    const Eigen::Isometry3d err = T_a_b_true.inverse() * r.T_a_b;
+    std::printf("two viewpoints, noise %.2f m: %zu / %zu keypoints, %zu matches, %zu inliers, error %.4f m %.4f deg\n",
+                sigma, a.keypoints.size(), b.keypoints.size(), matches.size(), r.inliers.size(),
+                err.translation().norm(), angleDeg(err));
+    EXPECT_LT(err.translation().norm(), 0.10) << sigma;
+    EXPECT_LT(angleDeg(err), 0.5) << sigma;
+    EXPECT_GE(r.inliers.size(), 10u) << sigma;
+  }
 }
 
 TEST(LinK3d, DegenerateInputsAreFlaggedNotFatal) {

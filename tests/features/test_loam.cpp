@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <array>
+#include <random>
 #include <set>
 
 namespace adit {
@@ -84,6 +85,20 @@ TEST(LoamFeatures, BoxRoomEdgesAtCornersAndPlanesOnWalls) {
   EXPECT_LT(near_edge, static_cast<int>(f.surf_less_flat.size()) / 100) << near_edge;
   EXPECT_GT(f.surf_less_flat.size(), 1000u);
   EXPECT_LT(f.surf_less_flat.size(), f.cloud.points.size() / 2);
+}
+
+TEST(LoamFeatures, NoisyBoxRoomStillPicksTrueEdges) {
+  // 1 cm range noise (VLP-16 class). Measured: sharp picks median 9 mm, worst 39 mm from a true edge; with
+  // edge_min_offset at A-LOAM's 0.03 m, 81 of 143 sharp picks were noise more than 0.15 m from any edge.
+  const test::Scene scene = test::boxRoom();
+  LidarScan scan = test::scanScene(scene, Eigen::Isometry3d::Identity());
+  std::mt19937 rng(5);
+  std::normal_distribution<float> noise(0.0f, 0.01f);
+  for (LidarPoint& p : scan.points) p.p *= 1.0f + noise(rng) / p.p.norm();
+  const FeatureSet f = extract(scan);
+  ASSERT_GE(f.corner_sharp.size(), 30u);
+  for (const LidarPoint& p : f.corner_sharp) EXPECT_LT(distanceToBoxEdge(scene.boxes[0], p.p.cast<double>()), 0.06);
+  for (const LidarPoint& p : f.surf_flat) EXPECT_LT(scene.distance(p.p.cast<double>()), 0.05);
 }
 
 TEST(LoamFeatures, CorridorHasEdgesOnlyAlongTheWallFloorCreases) {
