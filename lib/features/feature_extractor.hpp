@@ -5,6 +5,7 @@
 #include "features/deskew.hpp"
 #include "features/feature_config.hpp"
 
+#include <utility>
 #include <vector>
 
 namespace adit {

@@ -1,5 +1,7 @@
 #include "features/link3d.hpp"
 
+#include "features/preprocess.hpp"
+
 #include <algorithm>
 #include <bitset>
 #include <cmath>
@@ -14,7 +16,7 @@ struct Cluster {
   Eigen::Vector3d sum = Eigen::Vector3d::Zero();
   double sum_rxy = 0.0;
   int count = 0;
-  std::bitset<128> rings;
+  std::bitset<kMaxRings> rings;
   double mean_x = 0.0, mean_y = 0.0, mean_rxy = 0.0;  // cached means (compared for every point)
 
   void add(const LidarPoint& p) {
@@ -22,7 +24,7 @@ struct Cluster {
     single.sum = p.p.cast<double>();
     single.sum_rxy = std::sqrt(single.sum.x() * single.sum.x() + single.sum.y() * single.sum.y());
     single.count = 1;
-    single.rings.set(p.ring % 128);
+    single.rings.set(p.ring % kMaxRings);
     absorb(single);
   }
   void absorb(const Cluster& o) {

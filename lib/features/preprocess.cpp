@@ -14,12 +14,13 @@ bool insideBox(const Eigen::Vector3f& p, const PreprocessConfig& cfg) {
   return enabled && (p.array() >= cfg.body_box_min.array()).all() && (p.array() <= cfg.body_box_max.array()).all();
 }
 
+// Beams of the sensor; a corrupt ring field cannot make us allocate 65536 rings (points beyond are dropped).
 int ringCount(const LidarScan& scan, const std::vector<LidarPoint>& pts, const PreprocessConfig& cfg) {
-  if (scan.num_beams > 0) return scan.num_beams;
-  if (!scan.has_ring) return std::max(1, cfg.num_rings);
+  if (scan.num_beams > 0) return std::min(scan.num_beams, kMaxRings);
+  if (!scan.has_ring) return std::clamp(cfg.num_rings, 1, kMaxRings);
   int max_ring = 0;
   for (const LidarPoint& p : pts) max_ring = std::max<int>(max_ring, p.ring);
-  return max_ring + 1;
+  return std::min(max_ring + 1, kMaxRings);
 }
 
 // Pointwise filters; counts what they drop.

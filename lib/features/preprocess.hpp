@@ -9,6 +9,9 @@
 
 namespace adit::features {
 
+// More beams than any spinning lidar has; rings at or beyond this are dropped as out of range.
+constexpr int kMaxRings = 256;
+
 struct PreprocessReport {
   int points_in = 0;
   int removed_invalid = 0;  // NaN / inf coordinates (or time)

@@ -151,6 +151,15 @@ TEST(Preprocess, DegenerateSweepsGiveFlaggedValidOutput) {
   EXPECT_FALSE(f.flags & FeatureSet::kEmptySweep);
   EXPECT_FALSE(f.surf_flat.empty());
 
+  LidarScan corrupt = roomScan();  // unknown beam count and one absurd ring index
+  corrupt.num_beams = 0;
+  corrupt.points[100].ring = 65535;
+  f = fx.process(corrupt, {}, MotionPrior{});
+  EXPECT_EQ(f.removed_range, 1);
+  EXPECT_EQ(f.cloud.num_beams, features::kMaxRings);
+  EXPECT_TRUE(f.flags & FeatureSet::kEmptyRing);  // rings 16..255 are empty
+  EXPECT_FALSE(f.surf_flat.empty());
+
   LidarScan few;  // three points on one ring: no window, no feature, no crash
   few.num_beams = 16;
   few.has_ring = few.has_time = true;
