@@ -74,6 +74,7 @@ LaunchSpec loadLaunchFile(const std::string& path, const std::map<std::string, s
       throw std::runtime_error("launch file '" + path + "': every process needs 'name' and a 'command' list");
     proc.name = p["name"].as<std::string>();
     for (const auto& arg : p["command"]) proc.command.push_back(sub(arg, proc.name + ".command"));
+    if (p["delay_s"]) proc.delay_s = p["delay_s"].as<double>();
     if (p["restart"]) proc.restart = parseRestart(p["restart"].as<std::string>(), path + ": " + proc.name);
     spec.processes.push_back(std::move(proc));
   }

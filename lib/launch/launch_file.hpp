@@ -14,6 +14,7 @@ struct ProcessSpec {
   std::string name;                  // prefix of its output lines and name of its log file
   std::vector<std::string> command;  // argv; "adit-*" and "adit" resolve to the build's bin/ first
   Restart restart = Restart::OnFailure;
+  double delay_s = 0.0;  // wait this long before the first start (let subscribers come up first)
 };
 
 struct LaunchSpec {

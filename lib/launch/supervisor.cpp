@@ -3,6 +3,7 @@
 #include "runtime/process.hpp"
 
 #include <fcntl.h>
+#include <fmt/format.h>
 #include <poll.h>
 #include <signal.h>
 #include <sys/wait.h>
@@ -62,6 +63,9 @@ bool start(Child& c, const LaunchSpec& spec, const SupervisorOptions& options) {
     ::close(fds[0]);
     ::close(fds[1]);
     if (!spec.lcm_url.empty()) ::setenv("LCM_DEFAULT_URL", spec.lcm_url.c_str(), 1);
+    // adit's own programs first, also for commands run through a shell.
+    const char* path = std::getenv("PATH");
+    ::setenv("PATH", (options.bin_dir + ":" + (path ? path : "/usr/bin:/bin")).c_str(), 1);
     std::vector<std::string> argv = c.spec.command;
     argv[0] = resolve(argv[0], options.bin_dir);
     std::vector<char*> cargv;
@@ -137,7 +141,7 @@ void stopAll(std::vector<Child>& children, const SupervisorOptions& options) {
     while (::waitpid(c.pid, &status, WNOHANG) == 0) {
       drain(c, options.echo);
       if (Clock::now() > deadline) {
-        say(c.spec.name + " did not stop within " + std::to_string(options.stop_timeout_s) + " s: killing it");
+        say(fmt::format("{} did not stop within {:g} s: killing it", c.spec.name, options.stop_timeout_s));
         ::kill(c.pid, SIGKILL);
         ::waitpid(c.pid, &status, 0);
         break;
@@ -168,6 +172,7 @@ int supervise(const LaunchSpec& spec, const SupervisorOptions& options) {
   }
   runtime::installStopHandlers();
   for (auto& c : children) {
+    if (c.spec.delay_s > 0) std::this_thread::sleep_for(seconds(c.spec.delay_s));
     c.log.open(fs::path(options.run_dir) / (c.spec.name + ".log"), std::ios::app);
     if (!start(c, spec, options)) {
       say("cannot start " + c.spec.name + ": " + std::strerror(errno));
@@ -197,13 +202,13 @@ int supervise(const LaunchSpec& spec, const SupervisorOptions& options) {
       c.pid = -1;
       const double ran_s = std::chrono::duration<double>(Clock::now() - c.started).count();
       if (std::find(spec.stop_when_exit.begin(), spec.stop_when_exit.end(), c.spec.name) != spec.stop_when_exit.end()) {
-        say(c.spec.name + " " + describe(status) + ": ending the run in " + std::to_string(spec.grace_s) + " s");
+        say(fmt::format("{} {}: ending the run in {:g} s", c.spec.name, describe(status), spec.grace_s));
         c.finished = true;
         const auto end = Clock::now() + seconds(spec.grace_s);
         if (!stop_at || end < *stop_at) stop_at = end;
       } else if (wantsRestart(c, status)) {
         if (ran_s > 30.0) c.backoff_s = 1.0;  // it had been healthy: start the back-off afresh
-        say(c.spec.name + " " + describe(status) + ": restarting in " + std::to_string(c.backoff_s) + " s");
+        say(fmt::format("{} {}: restarting in {:g} s", c.spec.name, describe(status), c.backoff_s));
         c.next_start = Clock::now() + seconds(c.backoff_s);
         c.backoff_s = std::min(30.0, c.backoff_s * 2.0);
       } else {
