@@ -2,6 +2,7 @@
 
 #include "mapping/downsample.hpp"
 #include "odometry/feature_fit.hpp"
+#include "odometry/motion_compensation.hpp"
 #include "odometry/pose_increment.hpp"
 
 namespace adit {
@@ -38,6 +39,7 @@ MapperConfig mapperConfigFrom(const Config& c) {
   m.local_map_radius_m = c.get<double>("mapping.local_map_radius_m", m.local_map_radius_m);
   m.global_map_resolution_m = c.get<double>("mapping.global_map_resolution_m", m.global_map_resolution_m);
   m.global_map_max_range_m = c.get<double>("mapping.global_map_max_range_m", m.global_map_max_range_m);
+  m.compensate_raw_sweeps = c.get<bool>("mapping.compensate_raw_sweeps", m.compensate_raw_sweeps);
   return m;
 }
 
@@ -65,15 +67,29 @@ Correspondences ScanToMapMapper::match(const std::vector<Eigen::Vector3d>& corne
   return m;
 }
 
-void ScanToMapMapper::addToMaps(const FeatureSet& f, const std::vector<Eigen::Vector3d>& corners,
-                                const std::vector<Eigen::Vector3d>& surfs, const Eigen::Isometry3d& T) {
-  corner_map_.insert(transformed(corners, T));
-  surf_map_.insert(transformed(surfs, T));
+ScanToMapMapper::Sweep ScanToMapMapper::prepare(const FeatureSet& f) const {
+  Sweep s;
+  s.utime = f.utime;
+  s.raw = !f.cloud.deskewed;
+  s.corners = f.corner_less_sharp;
+  s.surfs = f.surf_less_flat;
+  s.cloud = f.cloud.points;
+  return s;
+}
+
+void ScanToMapMapper::compensate(Sweep& s, const Eigen::Isometry3d& T_prev_curr, double gap_s) const {
+  for (auto* v : {&s.corners, &s.surfs, &s.cloud}) compensateMotion(*v, T_prev_curr, gap_s);
+  s.raw = false;
+}
+
+void ScanToMapMapper::addToMaps(const Sweep& s, const Eigen::Isometry3d& T) {
+  corner_map_.insert(transformed(voxelDownsample(toDouble(s.corners), config_.corner_resolution_m), T));
+  surf_map_.insert(transformed(voxelDownsample(toDouble(s.surfs), config_.surf_resolution_m), T));
   corner_map_.removeFarFrom(T.translation(), config_.local_map_radius_m);
   surf_map_.removeFarFrom(T.translation(), config_.local_map_radius_m);
   std::vector<Eigen::Vector3f> cloud;
-  cloud.reserve(f.cloud.points.size());
-  for (const LidarPoint& p : f.cloud.points) cloud.push_back(p.p);
+  cloud.reserve(s.cloud.size());
+  for (const LidarPoint& p : s.cloud) cloud.push_back(p.p);
   global_map_.insert(cloud, T, config_.global_map_max_range_m);
 }
 
@@ -84,9 +100,22 @@ PoseEstimate ScanToMapMapper::process(const FeatureSet& f, const PoseEstimate& o
   corrected_ = false;
   const Eigen::Isometry3d odom = isFinitePose(odometry.pose) ? odometry.pose : Eigen::Isometry3d::Identity();
   const Eigen::Isometry3d predicted = T_map_odom_ * odom;
-  const auto corners = voxelDownsample(toDouble(f.corner_less_sharp), config_.corner_resolution_m);
-  const auto surfs = voxelDownsample(toDouble(f.surf_less_flat), config_.surf_resolution_m);
 
+  // Raw (not deskewed) sweeps are compensated with the odometry's motion since the previous sweep; the very
+  // first one waits for that motion and enters the map when the second sweep arrives.
+  Sweep sweep = prepare(f);
+  const double gap_s = toSeconds(f.utime - previous_utime_);
+  const bool have_motion = has_previous_ && gap_s > 0;
+  const Eigen::Isometry3d motion = previous_odometry_.inverse() * odom;
+  if (config_.compensate_raw_sweeps && sweep.raw && have_motion) compensate(sweep, motion, gap_s);
+  if (pending_) {
+    if (have_motion) compensate(*pending_, motion, gap_s);
+    addToMaps(*pending_, pending_pose_);
+    pending_.reset();
+  }
+
+  const auto corners = voxelDownsample(toDouble(sweep.corners), config_.corner_resolution_m);
+  const auto surfs = voxelDownsample(toDouble(sweep.surfs), config_.surf_resolution_m);
   const bool first = corner_map_.empty() && surf_map_.empty();
   Eigen::Isometry3d T = predicted;
   bool ok = !first;
@@ -113,7 +142,15 @@ PoseEstimate ScanToMapMapper::process(const FeatureSet& f, const PoseEstimate& o
     if (!first) out.flags |= PoseEstimate::kRegistrationFailed;
   }
   T_map_odom_ = T * odom.inverse();
-  addToMaps(f, corners, surfs, T);
+  if (config_.compensate_raw_sweeps && sweep.raw && !have_motion) {
+    pending_ = std::move(sweep);
+    pending_pose_ = T;
+  } else {
+    addToMaps(sweep, T);
+  }
+  has_previous_ = true;
+  previous_utime_ = f.utime;
+  previous_odometry_ = odom;
   out.pose = T;
   return out;
 }
@@ -122,6 +159,7 @@ void ScanToMapMapper::applyCorrection(const Eigen::Isometry3d& T_corrected_uncor
   if (!isFinitePose(T_corrected_uncorrected)) return;
   T_map_odom_ = T_corrected_uncorrected * T_map_odom_;
   corner_map_.transform(T_corrected_uncorrected);
+  pending_pose_ = T_corrected_uncorrected * pending_pose_;
   surf_map_.transform(T_corrected_uncorrected);
   corrected_ = true;
 }

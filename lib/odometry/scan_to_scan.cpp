@@ -1,6 +1,7 @@
 #include "odometry/scan_to_scan.hpp"
 
 #include "odometry/feature_fit.hpp"
+#include "odometry/motion_compensation.hpp"
 #include "odometry/pose_increment.hpp"
 
 #include <algorithm>
@@ -30,6 +31,7 @@ ScanToScanConfig scanToScanConfigFrom(const Config& c) {
   s.plane_neighbours = c.get<int>("odometry.plane_neighbours", s.plane_neighbours);
   s.plane_max_point_distance_m = c.get<double>("odometry.plane_max_point_distance_m", s.plane_max_point_distance_m);
   s.ring_neighbours = c.get<int>("odometry.ring_neighbours", s.ring_neighbours);
+  s.compensate_mixed_deskew = c.get<bool>("odometry.compensate_mixed_deskew", s.compensate_mixed_deskew);
   s.use_link3d_seed = c.get<bool>("odometry.use_link3d_seed", s.use_link3d_seed);
   s.max_velocity_gap_s = c.get<double>("odometry.max_velocity_gap_s", s.max_velocity_gap_s);
   return s;
@@ -69,10 +71,11 @@ std::optional<PlaneFit> ScanToScanOdometry::fitLocalPlane(const Eigen::Vector3d&
   return fitPlane(pts, config_.plane_max_point_distance_m);
 }
 
-Correspondences ScanToScanOdometry::match(const FeatureSet& f, const Eigen::Isometry3d& T) const {
+Correspondences ScanToScanOdometry::match(const std::vector<LidarPoint>& sharp, const std::vector<LidarPoint>& flat,
+                                          const Eigen::Isometry3d& T) const {
   Correspondences m;
   const double max_sq = config_.max_match_distance_m * config_.max_match_distance_m;
-  for (const LidarPoint& lp : f.corner_sharp) {
+  for (const LidarPoint& lp : sharp) {
     if (!lp.p.allFinite()) continue;
     const Eigen::Vector3d p = lp.p.cast<double>(), q = T * p;
     const int j = prev_corners_.nearest(q, max_sq);
@@ -83,12 +86,34 @@ Correspondences ScanToScanOdometry::match(const FeatureSet& f, const Eigen::Isom
     if (dir.norm() < 1e-3) continue;
     m.lines.push_back({p, prev_corners_.point(j), dir.normalized()});
   }
-  for (const LidarPoint& lp : f.surf_flat) {
+  for (const LidarPoint& lp : flat) {
     if (!lp.p.allFinite()) continue;
     const Eigen::Vector3d p = lp.p.cast<double>(), q = T * p;
     if (const auto plane = fitLocalPlane(q, max_sq)) m.planes.push_back({p, plane->normal, plane->offset});
   }
   return m;
+}
+
+ScanToScanOdometry::Refinement ScanToScanOdometry::refine(const SweepPoints& cur, const Eigen::Isometry3d& seed,
+                                                         const Eigen::Isometry3d& hold) const {
+  Refinement out;
+  out.pose = seed;
+  out.ok = true;
+  for (int round = 0; round < std::max(1, config_.outer_iterations); ++round) {
+    out.result = registerStep(match(cur.sharp, cur.flat, out.pose), out.pose, hold, config_.registration);
+    out.iterations += out.result.iterations;
+    if (!(out.ok = out.result.ok)) break;
+    const bool converged = hasConverged(out.pose, out.result.pose);
+    out.pose = out.result.pose;
+    if (converged) break;
+  }
+  return out;
+}
+
+void ScanToScanOdometry::setPrevious(const SweepPoints& points) {
+  prev_points_ = points;
+  prev_corners_ = RingIndexedCloud(points.less_sharp);
+  prev_surfs_ = RingIndexedCloud(points.less_flat);
 }
 
 PoseEstimate ScanToScanOdometry::process(const FeatureSet& f, const std::optional<Eigen::Isometry3d>& prior,
@@ -110,25 +135,36 @@ PoseEstimate ScanToScanOdometry::process(const FeatureSet& f, const std::optiona
   const bool imu_prior = prior_usable && (prior_flags & PoseEstimate::kSeededByImu) != 0;
   const Eigen::Isometry3d hold = imu_prior ? *prior : motion_model;
 
-  Eigen::Isometry3d T = seed;
-  bool ok = has_previous_;
-  RegistrationResult r;
-  for (int round = 0; ok && round < std::max(1, config_.outer_iterations); ++round) {
-    r = registerStep(match(f, T), T, hold, config_.registration);
-    ok = r.ok;
-    out.iterations += r.iterations;
-    if (!ok) break;
-    const bool converged = hasConverged(T, r.pose);
-    T = r.pose;
-    if (converged) break;
+  SweepPoints cur{f.corner_sharp, f.surf_flat, f.corner_less_sharp, f.surf_less_flat};
+  const bool cur_raw = !f.cloud.deskewed;
+  const double gap_s = toSeconds(f.utime - previous_utime_);
+  // Exactly one side deskewed: compensate the raw side with the motion estimate, register, and repeat once
+  // with the refined motion (the seed may be poor exactly when this happens: at start-up).
+  const bool mixed = has_previous_ && config_.compensate_mixed_deskew && cur_raw != previous_raw_;
+  const SweepPoints raw_side = mixed ? (cur_raw ? cur : prev_points_) : SweepPoints{};
+  Refinement r;
+  r.pose = seed;
+  for (int pass = 0; has_previous_ && pass < (mixed ? 2 : 1); ++pass) {
+    if (mixed) {
+      SweepPoints fixed = raw_side;
+      for (auto* v : {&fixed.sharp, &fixed.flat, &fixed.less_sharp, &fixed.less_flat}) compensateMotion(*v, r.pose, gap_s);
+      if (cur_raw) cur = fixed; else setPrevious(fixed);
+    }
+    const int iterations = r.iterations;
+    r = refine(cur, r.pose, hold);
+    r.iterations += iterations;
+    if (!r.ok) break;
   }
-  if (ok) {
-    out.covariance = covarianceFrom(r.information, r.degeneracy, config_.registration.prior_sigma_translation_m,
+  out.iterations = r.iterations;
+  Eigen::Isometry3d T = r.pose;
+  if (has_previous_ && r.ok) {
+    out.covariance = covarianceFrom(r.result.information, r.result.degeneracy,
+                                    config_.registration.prior_sigma_translation_m,
                                     config_.registration.prior_sigma_rotation_rad);
-    out.translation_eigenvalues = r.degeneracy.translation_eigenvalues;
-    out.rotation_eigenvalues = r.degeneracy.rotation_eigenvalues;
-    out.flags |= r.degeneracy.flags;
-    out.final_cost = r.final_cost;
+    out.translation_eigenvalues = r.result.degeneracy.translation_eigenvalues;
+    out.rotation_eigenvalues = r.result.degeneracy.rotation_eigenvalues;
+    out.flags |= r.result.degeneracy.flags;
+    out.final_cost = r.result.final_cost;
   } else {
     T = seed;
     out.covariance = priorCovariance(config_.registration);
@@ -142,8 +178,9 @@ PoseEstimate ScanToScanOdometry::process(const FeatureSet& f, const std::optiona
     pose_ = pose_ * T;
   }
   out.pose = pose_;
-  prev_corners_ = RingIndexedCloud(f.corner_less_sharp);
-  prev_surfs_ = RingIndexedCloud(f.surf_less_flat);
+  // A compensated raw sweep counts as deskewed from now on.
+  setPrevious(cur);
+  previous_raw_ = cur_raw && !mixed;
   has_previous_ = true;
   previous_utime_ = f.utime;
   return out;

@@ -33,6 +33,10 @@ struct ScanToScanConfig {
   double plane_max_point_distance_m = 0.1;
   // Accept a prior flagged kSeededByLinK3d as initial guess (false = A-LOAM ablation: motion model only).
   bool use_link3d_seed = true;
+  // When exactly one of two consecutive sweeps arrives deskewed (start-up: the feature stage has no motion
+  // prior for the first sweeps), move the raw one's points to its end instant with the estimated motion
+  // (motion_compensation.hpp). Without this, KITTI's first deskewed pair errs by ~0.6 m.
+  bool compensate_mixed_deskew = true;
   // Longest gap between sweeps (s) over which the constant-velocity model extrapolates; beyond, no motion.
   double max_velocity_gap_s = 0.5;
 };
@@ -55,19 +59,34 @@ class ScanToScanOdometry {
   // Constant-velocity guess of T_prev_curr for a sweep at `utime` (identity before two sweeps were seen).
   Eigen::Isometry3d predictMotion(std::int64_t utime) const;
 
-  // The correspondences of f's sharp / flat points against the previous sweep at a guess of T_prev_curr
+  // The correspondences of sharp / flat points against the previous sweep at a guess of T_prev_curr
   // (what one registration round uses; public for diagnostics and tests).
-  Correspondences match(const FeatureSet& f, const Eigen::Isometry3d& T_prev_curr) const;
+  Correspondences match(const std::vector<LidarPoint>& sharp, const std::vector<LidarPoint>& flat,
+                        const Eigen::Isometry3d& T_prev_curr) const;
 
   const Eigen::Isometry3d& pose() const { return pose_; }
   void reset();
 
  private:
+  struct SweepPoints {
+    std::vector<LidarPoint> sharp, flat, less_sharp, less_flat;
+  };
+  struct Refinement {
+    bool ok = false;
+    Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+    RegistrationResult result;  // of the last round
+    int iterations = 0;
+  };
+  // Outer rounds (correspondences recomputed each) from `seed` until converged or out of rounds.
+  Refinement refine(const SweepPoints& cur, const Eigen::Isometry3d& seed, const Eigen::Isometry3d& hold) const;
+  void setPrevious(const SweepPoints& points);
   std::optional<PlaneFit> fitLocalPlane(const Eigen::Vector3d& q, double max_sq) const;
 
   ScanToScanConfig config_;
   RingIndexedCloud prev_corners_;  // previous corner_less_sharp, previous lidar frame
   RingIndexedCloud prev_surfs_;    // previous surf_less_flat
+  SweepPoints prev_points_;        // the previous sweep's features, kept to compensate them if they were raw
+  bool previous_raw_ = false;      // the previous sweep was not deskewed
   bool has_previous_ = false;
   std::int64_t previous_utime_ = 0;
   Eigen::Isometry3d pose_ = Eigen::Isometry3d::Identity();        // T_odom_lidar of the previous sweep

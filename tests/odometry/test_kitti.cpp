@@ -1,0 +1,130 @@
+// Odometry and mapping on real 64-beam data (kitti_mini 00, 01, 02; 10 scans each): relative pose error per
+// consecutive pair against ground truth in the lidar frame (T_velo_i = Tr^-1 P_i Tr, from lib/io).
+// Full pipeline as adit runs it: FeatureExtractor (deskew with the odometry's motion prior), LinK3D RANSAC
+// seed, scan-to-scan odometry, scan-to-map mapping.
+#include "core/geometry.hpp"
+#include "features/feature_extractor.hpp"
+#include "features/link3d_match.hpp"
+#include "io/kitti.hpp"
+#include "mapping/scan_to_map.hpp"
+#include "odometry/scan_to_scan.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <string>
+
+namespace adit {
+namespace {
+
+const std::string kRoot = std::string(ADIT_SHARED_DATA_DIR) + "/kitti_mini";
+constexpr double kDeg = M_PI / 180.0;
+
+struct PairErrors {
+  std::vector<double> odom_t, odom_r, map_t, map_r;
+  int seeded_by_link3d = 0, failed = 0;
+};
+
+// 64-beam settings: A-LOAM's HDL-64 map resolutions.
+MapperConfig kittiMapperConfig() {
+  MapperConfig m;
+  m.corner_resolution_m = 0.4;
+  m.surf_resolution_m = 0.8;
+  return m;
+}
+
+PairErrors runSequence(const std::string& name, bool use_link3d) {
+  const io::KittiSequence seq = io::KittiSequence::open(kRoot, name);
+  const Trajectory gt = seq.groundTruthLidar(seq.defaultPosesFile());
+  const FeatureExtractor fx{FeatureConfig{}};
+  ScanToScanOdometry odom;
+  ScanToMapMapper mapper(kittiMapperConfig());
+  PairErrors errors;
+  FeatureSet previous;
+  std::vector<PoseEstimate> odo, map;
+  for (std::size_t i = 0; i < seq.size(); ++i) {
+    const LidarScan scan = seq.scan(i);
+    MotionPrior motion;
+    if (i > 0) {
+      motion.T_prev_curr = odom.predictMotion(scan.utime);
+      motion.dt_s = toSeconds(scan.utime - seq.utime(i - 1));
+      motion.valid = i > 1;  // scans 0 and 1 arrive raw: no velocity yet (the odometry compensates)
+    }
+    const FeatureSet f = fx.process(scan, {}, motion);
+    std::optional<Eigen::Isometry3d> seed;
+    int seed_flags = 0;
+    if (i > 0 && use_link3d) {
+      const auto matches = matchLinK3d(previous, f, fx.config().link3d);
+      const RansacResult r = estimateTransformRansac(previous.keypoints, f.keypoints, matches, fx.config().ransac);
+      if (r.ok) seed = r.T_a_b, seed_flags = PoseEstimate::kSeededByLinK3d;
+    }
+    odo.push_back(odom.process(f, seed, seed_flags));
+    map.push_back(mapper.process(f, odo.back()));
+    if (odo.back().flags & PoseEstimate::kSeededByLinK3d) ++errors.seeded_by_link3d;
+    if ((odo.back().flags | map.back().flags) & PoseEstimate::kRegistrationFailed) ++errors.failed;
+    if (i > 0) {
+      const Eigen::Isometry3d truth = gt[i - 1].pose.inverse() * gt[i].pose;
+      const Eigen::Isometry3d eo = truth.inverse() * (odo[i - 1].pose.inverse() * odo[i].pose);
+      const Eigen::Isometry3d em = truth.inverse() * (map[i - 1].pose.inverse() * map[i].pose);
+      errors.odom_t.push_back(eo.translation().norm());
+      errors.odom_r.push_back(rotationAngle(eo) / kDeg);
+      errors.map_t.push_back(em.translation().norm());
+      errors.map_r.push_back(rotationAngle(em) / kDeg);
+      std::printf("  %s %zu->%zu moved %.2f m: odometry %.3f m %.3f deg, mapping %.3f m %.3f deg, flags %d/%d\n",
+                  name.c_str(), i - 1, i, truth.translation().norm(), errors.odom_t.back(), errors.odom_r.back(),
+                  errors.map_t.back(), errors.map_r.back(), odo.back().flags, map.back().flags);
+    }
+    previous = f;
+  }
+  return errors;
+}
+
+double worst(const std::vector<double>& v) { return v.empty() ? 0.0 : *std::max_element(v.begin(), v.end()); }
+
+class KittiOdometry : public ::testing::TestWithParam<const char*> {};
+
+// 01 (highway, few features) and 02 (rural) have reliable ground truth: 0.1 m and 0.3 deg per pair.
+// Measured: 01 worst 0.067 m / 0.20 deg (odometry), 0.063 m / 0.18 deg (mapping); 02 worst 0.058 m / 0.16 deg
+// and 0.056 m / 0.11 deg.
+TEST_P(KittiOdometry, RelativePoseErrorPerPairIsSmall) {
+  const PairErrors e = runSequence(GetParam(), true);
+  std::printf("%s worst: odometry %.3f m %.3f deg, mapping %.3f m %.3f deg; LinK3D-seeded %d/9\n", GetParam(),
+              worst(e.odom_t), worst(e.odom_r), worst(e.map_t), worst(e.map_r), e.seeded_by_link3d);
+  EXPECT_EQ(e.failed, 0);
+  ASSERT_EQ(e.odom_t.size(), 9u);
+  for (std::size_t i = 0; i < e.odom_t.size(); ++i) {
+    EXPECT_LT(e.odom_t[i], 0.1) << "pair " << i;
+    EXPECT_LT(e.odom_r[i], 0.3) << "pair " << i;
+    EXPECT_LT(e.map_t[i], 0.1) << "pair " << i;
+    EXPECT_LT(e.map_r[i], 0.3) << "pair " << i;
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Sequences, KittiOdometry, ::testing::Values("01", "02"));
+
+// 00: its ground truth for these frames is interpolated, not measured: every pair advances 0.86 m and turns
+// 0.139 deg about the same axis to 4 digits, while the car accelerates from ~0.67 to ~0.82 m per scan (data
+// README) and real pairs (01, 02) show 0.1-0.2 deg of pitch/roll jitter from pair to pair. Translation is
+// judged with the README's ~0.2 m allowance; rotation at 0.3 deg plus 0.1 deg for the missing jitter, and
+// its mean at 0.25 deg. Measured: worst 0.19 m / 0.32 deg, mean rotation 0.22 deg.
+TEST(KittiOdometry, Sequence00) {
+  const PairErrors e = runSequence("00", true);
+  std::printf("00 worst: odometry %.3f m %.3f deg, mapping %.3f m %.3f deg; LinK3D-seeded %d/9\n", worst(e.odom_t),
+              worst(e.odom_r), worst(e.map_t), worst(e.map_r), e.seeded_by_link3d);
+  EXPECT_EQ(e.failed, 0);
+  ASSERT_EQ(e.odom_t.size(), 9u);
+  double mean_odom_r = 0, mean_map_r = 0;
+  for (std::size_t i = 0; i < e.odom_t.size(); ++i) {
+    EXPECT_LT(e.odom_r[i], 0.4) << "pair " << i;
+    EXPECT_LT(e.map_r[i], 0.4) << "pair " << i;
+    EXPECT_LT(e.odom_t[i], 0.2) << "pair " << i;
+    EXPECT_LT(e.map_t[i], 0.2) << "pair " << i;
+    mean_odom_r += e.odom_r[i] / 9.0;
+    mean_map_r += e.map_r[i] / 9.0;
+  }
+  EXPECT_LT(mean_odom_r, 0.25);
+  EXPECT_LT(mean_map_r, 0.25);
+}
+
+}  // namespace
+}  // namespace adit
