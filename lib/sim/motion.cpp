@@ -4,6 +4,7 @@
 #include "sim/rng.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 
@@ -57,8 +58,10 @@ MotionConfig motionConfigFrom(const adit::Config& cfg) {
   c.track_width = cfg.get(p + "track_width", c.track_width);
   c.vibration_deg = cfg.get(p + "vibration_deg", c.vibration_deg);
   c.bounce = cfg.get(p + "bounce", c.bounce);
-  c.vibration_time = cfg.get(p + "vibration_time", c.vibration_time);
+  c.vibration_min_hz = cfg.get(p + "vibration_min_hz", c.vibration_min_hz);
+  c.vibration_max_hz = cfg.get(p + "vibration_max_hz", c.vibration_max_hz);
   c.knot_spacing = cfg.get(p + "knot_spacing", c.knot_spacing);
+  c.smoothing_window = cfg.get(p + "smoothing_window", c.smoothing_window);
   return c;
 }
 
@@ -87,8 +90,11 @@ PlannedMotion planMotion(const World& world, const MotionConfig& c, double durat
   for (int i = 0; i < n; ++i) t_grid[i + 1] = t_grid[i] + 2 * ds / std::max(1e-6, v[i] + v[i + 1]);
 
   // Distance and speed at time t: constant acceleration within a grid cell (v^2 linear in s).
+  // The smoothing below reaches smoothing_window back in time: start the plan that much later so the robot is
+  // exactly still for start_still seconds.
+  const double motion_start = c.start_still + std::max(0.0, c.smoothing_window);
   auto distanceAt = [&](double t, double& speed) {
-    t -= c.start_still;
+    t -= motion_start;
     if (t <= 0.0 || n == 0) {
       speed = 0.0;
       return 0.0;
@@ -111,37 +117,95 @@ PlannedMotion planMotion(const World& world, const MotionConfig& c, double durat
 
   PlannedMotion out;
   out.route_length = path.length();
+  out.lap_length = Path2d(world.route, c.corner_radius).length();
   const double dt = c.knot_spacing;
   const double t0 = 0.0;
   const int controls = static_cast<int>(std::ceil(horizon / dt)) + 4;
-  const double rho = std::exp(-dt / std::max(1e-3, c.vibration_time)), innovation = std::sqrt(1 - rho * rho);
-  Eigen::Vector4d vib = Eigen::Vector4d::Zero();  // pitch, roll, yaw, height: unit-variance AR(1) states
+  // Vibration: per axis (pitch, roll, yaw, height) 3 sinusoids, unit RMS in total.
+  struct Tone {
+    double omega, phase, amplitude;
+  };
+  std::array<std::array<Tone, 3>, 4> tones;
+  const double f_lo = std::max(0.05, c.vibration_min_hz), f_hi = std::max(f_lo, c.vibration_max_hz);
+  for (auto& axis : tones) {
+    double power = 0.0;
+    for (Tone& tone : axis) {
+      const double f = f_lo * std::pow(f_hi / f_lo, rng.uniform());
+      tone = {2 * M_PI * f, rng.uniform(0.0, 2 * M_PI), 1.0 / f};
+      power += 0.5 * tone.amplitude * tone.amplitude;
+    }
+    for (Tone& tone : axis) tone.amplitude /= std::sqrt(power);
+  }
+  auto vibration = [&](int axis, double t) {
+    double sum = 0.0;
+    for (const Tone& tone : tones[axis]) sum += tone.amplitude * std::sin(tone.omega * t + tone.phase);
+    return sum;
+  };
   std::vector<Eigen::Isometry3d> poses;
   poses.reserve(controls);
+  // Pass 1: planar pose along the path (with wander) at every knot; heading unwrapped.
+  std::vector<double> xs(controls), ys(controls), yaws(controls), speeds(controls), dists(controls);
   for (int k = 0; k < controls; ++k) {
     const double t = t0 + (k - 1) * dt;
-    double speed = 0.0;
-    const double s = distanceAt(t, speed);
-    const double s_path = std::min(s, path.length());
+    dists[k] = distanceAt(t, speeds[k]);
+    const double s_path = std::min(dists[k], path.length());
     const Path2d::Sample ps = path.at(s_path);
     const double offset = wander(s_path), slope = (wander(s_path + 0.05) - wander(s_path - 0.05)) / 0.1;
-    const Eigen::Vector2d normal(-std::sin(ps.heading), std::cos(ps.heading));
-    const Eigen::Vector2d xy = ps.position + offset * normal;
-    const double yaw = ps.heading + std::atan(slope);
+    const Eigen::Vector2d xy = ps.position + offset * Eigen::Vector2d(-std::sin(ps.heading), std::cos(ps.heading));
+    xs[k] = xy.x();
+    ys[k] = xy.y();
+    yaws[k] = ps.heading + std::atan(slope);
+    if (k > 0) yaws[k] = yaws[k - 1] + std::remainder(yaws[k] - yaws[k - 1], 2 * M_PI);
+  }
+  // Pass 2: a real vehicle cannot jump in curvature or acceleration (arcs start abruptly on the geometric path):
+  // smooth the planar motion with two passes of a centred moving average over smoothing_window seconds.
+  const int half_window = std::max(0, static_cast<int>(std::lround(0.5 * c.smoothing_window / dt)));
+  for (std::vector<double>* series : {&xs, &ys, &yaws}) {
+    for (int pass = 0; pass < 2 && half_window > 0; ++pass) {
+      std::vector<double> prefix(controls + 1, 0.0);
+      for (int k = 0; k < controls; ++k) prefix[k + 1] = prefix[k] + (*series)[k];
+      std::vector<double> out(controls);
+      for (int k = 0; k < controls; ++k) {
+        const int lo = std::max(0, k - half_window), hi = std::min(controls - 1, k + half_window);
+        const int w = std::min(k - lo, hi - k);  // symmetric window, shrinking at the ends
+        out[k] = (prefix[k + w + 1] - prefix[k - w]) / (2 * w + 1);
+      }
+      *series = out;
+    }
+  }
+  // Pass 3: height and attitude from the floor, vibration, lidar on its mast.
+  for (int k = 0; k < controls; ++k) {
+    const double t = t0 + (k - 1) * dt;
+    const double speed = speeds[k], s = dists[k];
+    const Eigen::Vector2d xy(xs[k], ys[k]);
+    const double yaw = yaws[k];
 
-    // Attitude from the ground under the four track corners.
+    // Attitude from the ground under the tracks: a least-squares plane through 5 samples along each track, so
+    // bumps shorter than the tracks are bridged as a real crawler does.
     const Eigen::Vector2d fwd(std::cos(yaw), std::sin(yaw)), left(-std::sin(yaw), std::cos(yaw));
-    auto ground = [&](double f, double l) {
-      const Eigen::Vector2d q = xy + f * fwd + l * left;
-      return world.groundHeight(q.x(), q.y());
-    };
-    const double hl = c.track_length / 2, hw = c.track_width / 2;
-    const double fl = ground(hl, hw), fr = ground(hl, -hw), rl = ground(-hl, hw), rr = ground(-hl, -hw);
-    const double z_ground = 0.25 * (fl + fr + rl + rr);
-    const double pitch_floor = -std::atan2(0.5 * (fl + fr - rl - rr), c.track_length);  // nose up = negative
-    const double roll_floor = std::atan2(0.5 * (fl + rl - fr - rr), c.track_width);     // left up = positive
+    double mean = 0.0, side_diff = 0.0, slope_num = 0.0, slope_den = 0.0;
+    double heights[2][5];
+    for (int side = 0; side < 2; ++side) {
+      for (int i = 0; i < 5; ++i) {
+        const double f = c.track_length * (i - 2) / 4.0, l = (side == 0 ? 0.5 : -0.5) * c.track_width;
+        const Eigen::Vector2d q = xy + f * fwd + l * left;
+        heights[side][i] = world.groundHeight(q.x(), q.y());
+        mean += heights[side][i] / 10.0;
+        side_diff += (side == 0 ? 1.0 : -1.0) * heights[side][i] / 5.0;
+      }
+    }
+    for (int side = 0; side < 2; ++side) {
+      for (int i = 0; i < 5; ++i) {
+        const double f = c.track_length * (i - 2) / 4.0;
+        slope_num += f * (heights[side][i] - mean);
+        slope_den += f * f;
+      }
+    }
+    const double z_ground = mean;
+    const double pitch_floor = -std::atan(slope_num / slope_den);      // nose up = negative pitch
+    const double roll_floor = std::atan2(side_diff, c.track_width);  // left side up = positive roll
 
-    for (int j = 0; j < 4; ++j) vib[j] = rho * vib[j] + innovation * rng.normal();
+    const Eigen::Vector4d vib(vibration(0, t), vibration(1, t), vibration(2, t), vibration(3, t));
     const double scale = std::min(1.5, speed / 1.0);
     const double sigma = c.vibration_deg * kDegToRad * scale;
     const Eigen::Matrix3d R = (Eigen::AngleAxisd(yaw + sigma / 3 * vib[2], Eigen::Vector3d::UnitZ()) *

@@ -6,8 +6,12 @@
 //    in corners (turns at junctions), accelerations limited to max_accel / max_decel, starting from rest after
 //    a still period (lets IMU-based pipelines initialise gravity and biases) and stopping at the route's end;
 //  - a slow lateral wander around the centre line (nobody drives a perfect line);
-//  - height, pitch and roll from the floor relief under the four track corners (so pitch/roll really come from
-//    the rugged floor), plus crawler vibration (AR(1) noise in pitch, roll, yaw and height, scaled by speed);
+//  - the planar motion is smoothed (moving average, twice, over smoothing_window) so curvature and acceleration
+//    change continuously, as a real vehicle's do;
+//  - height, pitch and roll from a plane fitted to the floor under the two tracks (so pitch/roll really come from
+//    the rugged floor; bumps shorter than the tracks are bridged), plus chassis vibration in pitch, roll, yaw and height: per axis a sum of 3 sinusoids with
+//    seeded frequencies in [vibration_min_hz, vibration_max_hz] (amplitude ~ 1/f), scaled by speed, so it is
+//    band-limited like a real chassis and its accelerations stay physical;
 //  - the lidar sits mount_height above the ground on the body z axis; the IMU is at the lidar (identity extrinsic).
 // The resulting poses are sampled every knot_spacing seconds and become the control points of the spline; the
 // spline IS the ground truth (its derivatives feed the IMU).
@@ -33,12 +37,14 @@ struct MotionConfig {
   double wander = 0.15;          // m, amplitude of the lateral wander around the centre line
   double start_still = 2.0;      // s standing still at the start
   double mount_height = 1.0;     // m, lidar above the ground contact
-  double track_length = 1.2;     // m, contact patch distance front-rear (pitch from the floor)
-  double track_width = 0.8;      // m, left-right (roll from the floor)
+  double track_length = 1.2;     // m, length of the tracks on the ground (pitch from the floor)
+  double track_width = 0.8;      // m, distance between the tracks (roll from the floor)
   double vibration_deg = 0.3;    // deg RMS pitch/roll vibration at 1 m/s (yaw gets a third of it)
   double bounce = 0.004;         // m RMS vertical vibration at 1 m/s
-  double vibration_time = 0.08;  // s, correlation time of the vibration
-  double knot_spacing = 0.02;    // s between spline control points (vibration content up to ~10 Hz)
+  double vibration_min_hz = 0.8; // chassis vibration band (Hz)
+  double vibration_max_hz = 4.0;
+  double knot_spacing = 0.02;    // s between spline control points (>= 12 knots per vibration period)
+  double smoothing_window = 0.6; // s, moving average (twice) over the planar path: smooth curvature and jerk
 };
 
 // Keys "sim.motion.<field>" with the defaults above.
@@ -49,6 +55,7 @@ struct PlannedMotion {
   // Distance along the route driven by time knot_times[k] (monotonic): for "how long to drive X metres".
   std::vector<double> knot_times, knot_distance;
   double route_length = 0.0;  // total length of the (possibly repeated) route that was planned (m)
+  double lap_length = 0.0;    // length of one pass of world.route as driven (corners rounded) (m)
   double timeAtDistance(double metres) const;  // first time the robot has driven `metres`; +inf if never
 };
 

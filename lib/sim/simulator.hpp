@@ -12,10 +12,11 @@
 // Determinism: everything is a pure function of SimConfig; each sweep's noise has its own random stream, so
 // simulateSweep(k) alone gives the same scan as the k-th sweep of the stream.
 //
-// Demo duration: on roadway-loop (500 m perimeter) at the default cruise speed 1.3 m/s the robot drives one lap in
-// about 400 s and 1.2 laps (600 m) in about 480 s after the 2 s start; the exact figures for a config are
-// timeAtDistance(lapLength()) and timeAtDistance(1.2 * lapLength()). Use --duration 480 for a loop closure with
-// real revisit (test_sim prints and checks these numbers).
+// Demo duration: roadway-loop's circuit is 510 m (507 m as driven, corners rounded); at the default cruise speed
+// 1.3 m/s the robot completes one lap about 400 s after time 0 and 1.2 laps (608 m) at about 480 s (it stands
+// still for the first 2 s). Use --duration 500 for the demo: a loop closure with a real revisit. The exact
+// figures for a config are timeAtDistance(lapLength()) and timeAtDistance(1.2 * lapLength()); test_sim prints
+// and checks them.
 #pragma once
 
 #include "core/config.hpp"
@@ -86,8 +87,8 @@ class Simulator {
   const PlannedMotion& motion() const { return motion_; }
   const LidarSimulator& lidar() const { return lidar_; }
 
-  // Length of one lap of a closed route (m), or of the whole route if open.
-  double lapLength() const { return world_->routeLength(); }
+  // Length of one lap of a closed route as driven (corners rounded) (m), or of the whole route if open.
+  double lapLength() const { return motion_.lap_length; }
   // Seconds after time 0 at which the robot has driven `metres`; +inf if not within the planned horizon.
   double timeAtDistance(double metres) const { return motion_.timeAtDistance(metres); }
 

@@ -3,7 +3,7 @@
 //
 // Built-in worlds (name -> layout, all sizes overridable in WorldConfig):
 //   roadway-straight  one 320 m roadway, arched roof, bolts, steel arches, pipes, cables, niches, equipment.
-//   roadway-loop      a 170 m x 80 m rectangle of roadways (500 m perimeter) with 2 cross-cuts and dead-end stubs;
+//   roadway-loop      a 175 m x 80 m rectangle of roadways (510 m perimeter) with 2 cross-cuts and dead-end stubs;
 //                     the robot drives the perimeter counter-clockwise, lap after lap (a real revisit for loop
 //                     closure). See simulator.hpp for the duration needed to drive 1.2 laps.
 //   room-and-pillar   a 6 x 6 grid of junctions between 15 m square pillars: many identical intersections
@@ -37,8 +37,8 @@ struct WorldConfig {
   double roof_rise = 0.6;    // arch rise above the wall tops (m); 0 = flat roof (rectangular section)
 
   // Relief (RMS, m). Floor relief also makes the robot pitch and roll.
-  double floor_roughness = 0.04;  // wavelengths 0.8-12 m: rutted, uneven floor
-  double wall_roughness = 0.03;   // wavelengths 0.7-6 m on walls and roof: cut coal, spalling
+  double floor_roughness = 0.03;  // wavelengths 1.5-12 m: rutted, uneven floor (robot pitch/roll of a few deg)
+  double wall_roughness = 0.03;   // wavelengths 1.5-6 m on walls and roof: cut coal, spalling
   double grade_amplitude = 1.0;   // slow up/down of the whole roadway, wavelengths 150-400 m (slopes < ~2 deg)
 
   // Furniture: what gives a 16-beam lidar its only features in a roadway.
@@ -52,7 +52,7 @@ struct WorldConfig {
 
   // Layout sizes.
   double straight_length = 320.0;  // roadway-straight and featureless (m)
-  double loop_size_x = 170.0;      // roadway-loop rectangle (m): perimeter 2 * (x + y) = 500 m
+  double loop_size_x = 175.0;      // roadway-loop rectangle (m): perimeter 2 * (x + y) = 510 m, 507 m driven
   double loop_size_y = 80.0;
   int loop_crosscuts = 2;       // north-south roadways across the loop
   int pillar_grid = 6;          // room-and-pillar: junctions per side
