@@ -1,0 +1,61 @@
+// Puts each decoded packet on the output time line (ns since 1970, host clock), which must never go back.
+//
+// kSensor: the sensor's own stamp gives the firing times (exact spacing, no network jitter). Its zero is
+//   arbitrary (a free-running Velodyne counts from power-on unless a GPS sets it; a RoboSense without sync
+//   starts at some default date), so the first packet anchors it to its host receive time: output =
+//   host_receive(first) - packet duration + (stamp - stamp(first)). The Velodyne's us-past-the-hour stamp
+//   is unwrapped at the hour. A jump of the sensor clock by more than max_jump (GPS lock, a reset) re-anchors
+//   on the host clock, as at the first packet.
+// kHost: the host receive time (kernel stamp) minus the packet's duration is the first firing. Network
+//   jitter can make a packet start a little before the previous one ended; up to one packet duration of
+//   overlap is shifted forward (counted), more is a time step back.
+// A packet that would still start before the previous packet's last firing is refused (counted by the
+// caller as "time_backwards") and the clock stays as it was.
+#pragma once
+
+#include "drivers/firing.hpp"
+
+#include <cstdint>
+#include <optional>
+
+namespace adit::drivers {
+
+enum class TimeSource { kSensor, kHost };
+
+struct PacketClockConfig {
+  TimeSource source = TimeSource::kSensor;
+  // Sensor clock steps larger than this (either way, s) re-anchor on the host clock. 1 s: far above the
+  // 1.3 ms packet spacing and any network delay, far below a GPS correction of a free-running clock.
+  double max_jump_s = 1.0;
+};
+
+struct PacketTime {
+  std::int64_t first_firing_ns = 0;  // output time of the packet's first firing
+  bool reanchored = false;           // kSensor: the sensor clock jumped and was re-anchored
+  bool shifted = false;              // kHost: shifted forward over the previous packet's end
+};
+
+class PacketClock {
+ public:
+  explicit PacketClock(const PacketClockConfig& config) : config_(config) {}
+
+  // host_receive_ns: when the packet arrived (ns since 1970). nullopt: the packet would go back in time.
+  std::optional<PacketTime> place(const DecodedPacket& packet, std::int64_t host_receive_ns);
+
+ private:
+  std::optional<PacketTime> placeBySensor(const DecodedPacket& packet, std::int64_t host_receive_ns);
+  std::optional<PacketTime> placeByHost(const DecodedPacket& packet, std::int64_t host_receive_ns);
+  // Accepts a packet starting at first_ns if it does not start before the previous one ended.
+  bool accept(std::int64_t first_ns, const DecodedPacket& packet);
+
+  PacketClockConfig config_;
+  bool anchored_ = false;
+  std::int64_t anchor_host_ns_ = 0;    // output time of the anchor packet's first firing
+  std::int64_t anchor_stamp_us_ = 0;   // its unwrapped sensor stamp
+  std::int64_t last_stamp_us_ = 0;     // unwrapped stamp of the last accepted packet
+  std::int64_t hour_wraps_ = 0;        // kMicrosPastHour: hours added to the raw stamp
+  bool have_last_ = false;
+  std::int64_t last_end_ns_ = 0;       // output time of the last accepted packet's last firing
+};
+
+}  // namespace adit::drivers
