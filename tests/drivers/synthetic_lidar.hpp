@@ -1,0 +1,53 @@
+// A synthetic spinning 16-beam lidar for the driver tests: writes VLP-16 / RS-16 packets byte by byte from
+// a known scene (written from the manuals' packet layouts, independently of lib/drivers) and returns the
+// ground truth of every firing: time, continuous azimuth, laser, ring, range, intensity and position.
+#pragma once
+
+#include <Eigen/Core>
+
+#include <cstdint>
+#include <vector>
+
+namespace adit::drivers::testing {
+
+enum class Model { kVlp16, kRs16 };
+
+struct TruthFiring {
+  std::int64_t t_ns = 0;      // since the first firing of packet 0 (exact; sensor stamps are whole us)
+  std::int64_t offset_ns = 0; // since the first firing of its packet
+  double azimuth_deg = 0.0;   // [0, 360)
+  int laser = 0;
+  int ring = 0;
+  double range_m = 0.0;       // 0 = no return
+  int intensity = 0;
+  bool has_return = false;    // false also for a dual-return echo equal to the first one
+  Eigen::Vector3d p = Eigen::Vector3d::Zero();
+};
+
+struct SyntheticLidar {
+  Model model = Model::kVlp16;
+  int az0_centideg = 1234;    // azimuth of block 0 of packet 0
+  int gap_centideg = 40;      // azimuth advance per firing block (0.40 deg: ~10 Hz)
+  std::int64_t stamp0_us = 0; // sensor stamp of packet 0 (VLP-16: us past the hour; RS-16: UTC us)
+  bool dual = false;          // VLP-16 dual-return packets
+  double no_return_fraction = 0.05;
+  std::uint64_t seed = 1;
+
+  // Packet k of the stream; appends its firings (in packet order) to *truth if given.
+  std::vector<std::uint8_t> packet(int k, std::vector<TruthFiring>* truth = nullptr) const;
+  std::int64_t blockNs() const;          // time between firing blocks (groups in dual mode)
+  int groupsPerPacket() const;           // 12, or 6 in dual mode
+  std::int64_t packetNs() const { return blockNs() * groupsPerPacket(); }
+  std::int64_t lastFiringNs() const;     // offset of a packet's last firing
+  double rotationNs() const { return 36000.0 / gap_centideg * static_cast<double>(blockNs()); }
+  std::int64_t stampUs(int k) const;     // sensor stamp of packet k
+};
+
+// Nominal elevation (deg) and ring of a laser id, from the manuals' tables.
+double elevationDeg(Model model, int laser);
+int ringOf(Model model, int laser);
+
+// Fixed RS-16 packet date: 2024-03-15 10:20:30.000000 UTC.
+constexpr std::int64_t kRs16TestEpochUs = 1710498030LL * 1000000;
+
+}  // namespace adit::drivers::testing

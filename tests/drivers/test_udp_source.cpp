@@ -1,0 +1,166 @@
+// End to end over real UDP: synthetic VLP-16 packets sent to 127.0.0.1 (unicast loopback, a random high
+// port) reach makeUdpLidarSource, which must yield the same sweeps as the packets decoded offline, as
+// encoded point_cloud_t messages. Bounded: a fixed number of packets, then the source's idle timeout ends it.
+#include "drivers/lidar_stream.hpp"
+#include "drivers/udp_lidar_source.hpp"
+#include "msg/convert.hpp"
+#include "synthetic_lidar.hpp"
+
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <chrono>
+#include <random>
+#include <thread>
+
+namespace adit::drivers {
+namespace {
+
+using testing::SyntheticLidar;
+
+// Sends `packets` to 127.0.0.1:port, one every `spacing` (a real VLP-16 sends one per 1.33 ms).
+void sendPackets(const std::vector<std::vector<std::uint8_t>>& packets, std::uint16_t port,
+                 std::chrono::microseconds spacing) {
+  const int fd = socket(AF_INET, SOCK_DGRAM, 0);
+  ASSERT_GE(fd, 0);
+  sockaddr_in to{};
+  to.sin_family = AF_INET;
+  to.sin_port = htons(port);
+  to.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  auto due = std::chrono::steady_clock::now();
+  for (const auto& p : packets) {
+    std::this_thread::sleep_until(due);
+    due += spacing;
+    ASSERT_EQ(sendto(fd, p.data(), p.size(), 0, reinterpret_cast<const sockaddr*>(&to), sizeof(to)),
+              static_cast<ssize_t>(p.size()));
+  }
+  close(fd);
+}
+
+TEST(UdpLidarSource, SweepsFromRealUdpPackets) {
+  SyntheticLidar lidar;
+  lidar.stamp0_us = 3599000000LL;  // crosses the sensor's hour wrap on the way
+  const int n = 270;               // 3.6 revolutions -> 3 complete sweeps
+  std::vector<std::vector<std::uint8_t>> packets;
+  for (int k = 0; k < n; ++k) packets.push_back(lidar.packet(k));
+  packets.insert(packets.begin() + 100, std::vector<std::uint8_t>(512, 0xAB));  // a stray datagram
+
+  // Offline reference: the same packets through the pure stream.
+  UdpLidarConfig config;
+  config.idle_timeout_s = 0.5;
+  config.bind_address = "127.0.0.1";  // loopback only: nothing from the network reaches the test
+  std::vector<LidarScan> expected;
+  {
+    LidarPacketStream stream(streamConfigOf(config));
+    std::int64_t t = 1000000000000000000LL;
+    for (const auto& p : packets) stream.push(p.data(), p.size(), t += 1327104, expected);
+  }
+  ASSERT_EQ(expected.size(), 3u);
+
+  // A random high port; another program may hold it, so try a few.
+  std::mt19937 rng(std::random_device{}());
+  std::unique_ptr<runtime::MessageSource> source;
+  for (int attempt = 0; attempt < 20 && !source; ++attempt) {
+    config.port = 20000 + static_cast<int>(rng() % 40000);
+    try {
+      source = makeUdpLidarSource(config, [] { return false; });
+    } catch (const std::runtime_error&) {
+    }
+  }
+  ASSERT_TRUE(source) << "no free UDP port";
+
+  std::thread sender(sendPackets, std::cref(packets), static_cast<std::uint16_t>(config.port),
+                     std::chrono::microseconds(500));
+  std::vector<runtime::OutgoingMessage> messages;
+  runtime::OutgoingMessage m;
+  const auto start = std::chrono::steady_clock::now();
+  while (source->next(m)) messages.push_back(m);  // ends 0.5 s after the last packet
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  sender.join();
+
+  const runtime::Health& h = source->health();
+  EXPECT_EQ(h.inputs, n + 1) << "datagrams lost on loopback";
+  EXPECT_EQ(h.errors, 1);
+  EXPECT_EQ(h.counters.at("wrong_size"), 1);
+  EXPECT_EQ(h.outputs, 3);
+  ASSERT_EQ(messages.size(), expected.size());
+  for (std::size_t j = 0; j < messages.size(); ++j) {
+    EXPECT_EQ(messages[j].channel, "LIDAR_POINTS");
+    adit::point_cloud_t msg;
+    ASSERT_GE(msg.decode(messages[j].data.data(), 0, static_cast<int>(messages[j].data.size())), 0);
+    const LidarScan s = msg::fromMessage(msg);
+    const LidarScan& e = expected[j];
+    EXPECT_EQ(messages[j].utime, s.utime);
+    EXPECT_EQ(s.seq, e.seq);
+    EXPECT_EQ(s.sensor, "vlp16");
+    EXPECT_EQ(s.num_beams, 16);
+    EXPECT_TRUE(s.has_ring && s.has_time);
+    // Sweeps are anchored on the receive time of the first packet: compare the spacing, not the origin.
+    if (j > 0) {
+      EXPECT_EQ(s.utime - messages[j - 1].utime, e.utime - expected[j - 1].utime);
+    }
+    EXPECT_NEAR(s.sweep_duration, e.sweep_duration, 1e-7);
+    ASSERT_EQ(s.points.size(), e.points.size());
+    for (std::size_t i = 0; i < e.points.size(); ++i) {
+      EXPECT_EQ(s.points[i].p, e.points[i].p);
+      EXPECT_EQ(s.points[i].ring, e.points[i].ring);
+      EXPECT_EQ(s.points[i].intensity, e.points[i].intensity);
+      EXPECT_EQ(s.points[i].dt, e.points[i].dt);
+    }
+  }
+  // utime is host time (us since 1970): within a minute of now.
+  const auto now_us = std::chrono::duration_cast<std::chrono::microseconds>(
+                          std::chrono::system_clock::now().time_since_epoch()).count();
+  EXPECT_LT(std::abs(messages.back().utime - now_us), 60000000);
+  std::cout << n << " packets over UDP -> " << messages.size() << " sweeps in " << seconds << " s\n";
+}
+
+TEST(UdpLidarSource, BadConfigIsRefusedUpFront) {
+  UdpLidarConfig c;
+  c.model = "hdl64";
+  EXPECT_THROW(makeUdpLidarSource(c), std::invalid_argument);
+  c = UdpLidarConfig{};
+  c.time_source = "gps";
+  EXPECT_THROW(makeUdpLidarSource(c), std::invalid_argument);
+  c = UdpLidarConfig{};
+  c.vertical_angles_deg = {1, 2, 3};
+  EXPECT_THROW(makeUdpLidarSource(c), std::invalid_argument);
+  c = UdpLidarConfig{};
+  c.bind_address = "not-an-address";
+  c.port = 1;
+  EXPECT_THROW(makeUdpLidarSource(c), std::runtime_error);
+}
+
+TEST(UdpLidarSource, ConfigKeys) {
+  const Config c = Config::fromYamlString(
+      "lidar_driver:\n  model: rs16\n  port: 7000\n  time_source: host\n  cut_azimuth_deg: 90\n"
+      "  vertical_angles_deg: [-15.1, -13, -11, -9, -7, -5, -3, -1, 15, 13, 11, 9, 7, 5, 3, 1.2]\n"
+      "  idle_timeout_s: 2\n  channel: LIDAR_RS\n");
+  const UdpLidarConfig d = udpLidarConfigFrom(c);
+  EXPECT_EQ(d.model, "rs16");
+  EXPECT_EQ(d.port, 7000);
+  EXPECT_EQ(d.channel, "LIDAR_RS");
+  ASSERT_EQ(d.vertical_angles_deg.size(), 16u);
+  EXPECT_DOUBLE_EQ(d.vertical_angles_deg[0], -15.1);
+  const LidarStreamConfig s = streamConfigOf(d);
+  EXPECT_EQ(s.model, LidarModel::kRs16);
+  EXPECT_EQ(s.clock.source, TimeSource::kHost);
+  EXPECT_EQ(s.sweep.cut_azimuth_deg, 90.0);
+  EXPECT_EQ(s.sweep.sensor, "rs16");
+  const UdpLidarConfig defaults = udpLidarConfigFrom(Config{});
+  EXPECT_EQ(dataPortOf(defaults), 2368);
+  EXPECT_EQ(defaults.time_source, "sensor");
+  EXPECT_EQ(defaults.cut_azimuth_deg, 180.0);
+  EXPECT_EQ(dataPortOf(d), 7000);
+  UdpLidarConfig rs;
+  rs.model = "rs16";
+  EXPECT_EQ(dataPortOf(rs), 6699);
+}
+
+}  // namespace
+}  // namespace adit::drivers
