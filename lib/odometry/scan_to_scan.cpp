@@ -30,6 +30,9 @@ ScanToScanConfig scanToScanConfigFrom(const Config& c) {
   s.ring_window = c.get<int>("odometry.ring_window", s.ring_window);
   s.plane_neighbours = c.get<int>("odometry.plane_neighbours", s.plane_neighbours);
   s.plane_max_point_distance_m = c.get<double>("odometry.plane_max_point_distance_m", s.plane_max_point_distance_m);
+  s.line_min_rings = c.get<int>("odometry.line_min_rings", s.line_min_rings);
+  s.line_eigen_ratio = c.get<double>("odometry.line_eigen_ratio", s.line_eigen_ratio);
+  s.line_max_point_distance_m = c.get<double>("odometry.line_max_point_distance_m", s.line_max_point_distance_m);
   s.ring_neighbours = c.get<int>("odometry.ring_neighbours", s.ring_neighbours);
   s.compensate_mixed_deskew = c.get<bool>("odometry.compensate_mixed_deskew", s.compensate_mixed_deskew);
   s.use_link3d_seed = c.get<bool>("odometry.use_link3d_seed", s.use_link3d_seed);
@@ -46,6 +49,36 @@ Eigen::Isometry3d ScanToScanOdometry::predictMotion(std::int64_t utime) const {
   if (!has_previous_ || last_gap_us_ <= 0 || gap <= 0 || toSeconds(gap) > config_.max_velocity_gap_s)
     return Eigen::Isometry3d::Identity();
   return scaleMotion(last_motion_, static_cast<double>(gap) / static_cast<double>(last_gap_us_));
+}
+
+std::optional<LineFit> ScanToScanOdometry::fitLocalLine(const Eigen::Vector3d& q, double max_sq) const {
+  // The nearest previous edge point and the nearest on each ring within ring_window of it: one point per
+  // ring, so the line follows the edge across rings. A-LOAM takes two (the nearest and one on another ring);
+  // requiring line_min_rings of them to be collinear rejects the "edges" that are only where a ring crosses a
+  // curvature change (floor-wall junction, arch springing): those move with the sensor and, matched as A-LOAM
+  // does, pull the motion estimate towards zero in tunnels.
+  const int j = prev_corners_.nearest(q, max_sq);
+  if (j < 0) return std::nullopt;
+  const int ring = prev_corners_.ring(j);
+  std::vector<Eigen::Vector3d> pts{prev_corners_.point(j)};
+  for (int r = ring - config_.ring_window; r <= ring + config_.ring_window; ++r) {
+    if (r == ring) continue;
+    const int k = prev_corners_.nearestInRing(r, q, max_sq, -1);
+    if (k >= 0) pts.push_back(prev_corners_.point(k));
+  }
+  if (static_cast<int>(pts.size()) < std::max(2, config_.line_min_rings)) return std::nullopt;
+  if (pts.size() == 2) {  // A-LOAM's two-point line
+    const Eigen::Vector3d d = pts[1] - pts[0];
+    if (d.norm() < 1e-3) return std::nullopt;
+    return LineFit{pts[0], d.normalized()};
+  }
+  const auto line = fitLine(pts, config_.line_eigen_ratio);
+  if (!line) return std::nullopt;
+  for (const Eigen::Vector3d& x : pts) {
+    const Eigen::Vector3d d = x - line->centroid;
+    if ((d - line->direction * line->direction.dot(d)).norm() > config_.line_max_point_distance_m) return std::nullopt;
+  }
+  return line;
 }
 
 std::optional<PlaneFit> ScanToScanOdometry::fitLocalPlane(const Eigen::Vector3d& q, double max_sq) const {
@@ -78,13 +111,7 @@ Correspondences ScanToScanOdometry::match(const std::vector<LidarPoint>& sharp, 
   for (const LidarPoint& lp : sharp) {
     if (!lp.p.allFinite()) continue;
     const Eigen::Vector3d p = lp.p.cast<double>(), q = T * p;
-    const int j = prev_corners_.nearest(q, max_sq);
-    if (j < 0) continue;
-    const int l = prev_corners_.nearestInNeighbourRings(prev_corners_.ring(j), config_.ring_window, q, max_sq);
-    if (l < 0) continue;
-    const Eigen::Vector3d dir = prev_corners_.point(l) - prev_corners_.point(j);
-    if (dir.norm() < 1e-3) continue;
-    m.lines.push_back({p, prev_corners_.point(j), dir.normalized()});
+    if (const auto line = fitLocalLine(q, max_sq)) m.lines.push_back({p, line->centroid, line->direction});
   }
   for (const LidarPoint& lp : flat) {
     if (!lp.p.allFinite()) continue;

@@ -23,6 +23,12 @@ struct ScanToScanConfig {
   double max_match_distance_m = 3.0;
   // Rings either side searched for the second line point / third plane point (A-LOAM: 2.5 -> 2).
   int ring_window = 2;
+  // Edge lines: the nearest previous less-sharp point and the nearest on each ring within ring_window; at
+  // least line_min_rings such points (one per ring) must be collinear: PCA ratio above line_eigen_ratio and
+  // none farther than line_max_point_distance_m from the line. 2 reproduces A-LOAM's two-point line.
+  int line_min_rings = 3;
+  double line_eigen_ratio = 3.0;
+  double line_max_point_distance_m = 0.1;
   // Planes are fitted (least squares) to the plane_neighbours nearest previous less-flat points plus the
   // ring_neighbours nearest on each ring within ring_window of the closest one, and rejected if any of them
   // is farther than plane_max_point_distance_m from the plane (A-LOAM mapping uses 0.2 m; tighter here
@@ -80,6 +86,7 @@ class ScanToScanOdometry {
   // Outer rounds (correspondences recomputed each) from `seed` until converged or out of rounds.
   Refinement refine(const SweepPoints& cur, const Eigen::Isometry3d& seed, const Eigen::Isometry3d& hold) const;
   void setPrevious(const SweepPoints& points);
+  std::optional<LineFit> fitLocalLine(const Eigen::Vector3d& q, double max_sq) const;
   std::optional<PlaneFit> fitLocalPlane(const Eigen::Vector3d& q, double max_sq) const;
 
   ScanToScanConfig config_;
