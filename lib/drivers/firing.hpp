@@ -24,7 +24,7 @@ enum class PacketStatus {
   kBadMagic,          // RS-16 header does not start with 55 AA 05 0A 5A A5 50 A0
   kBadBlockFlag,      // a data block does not start with FF EE
   kBadAzimuth,        // a block azimuth >= 360.00 deg
-  kBadTimestamp,      // RS-16 header date/time fields out of range
+  kBadTimestamp,      // RS-16 header date/time out of range while the sensor clock is used
   kUnknownProduct,    // VLP-16 factory byte is not 0x22 (VLP-16) or 0x00 (firmware before 3.0.29)
   kUnknownReturnMode  // VLP-16 factory byte is not 0x37 / 0x38 / 0x39 (or 0x00)
 };
@@ -48,6 +48,7 @@ struct Firing {
 
 struct DecodedPacket {
   std::int64_t stamp_us = 0;  // sensor clock at the packet's first firing
+  bool stamp_valid = true;    // false: RS-16 header date/time out of range (usable only on host time)
   SensorClock clock = SensorClock::kMicrosPastHour;
   std::int64_t duration_ns = 0;  // offset of the packet's last firing
   bool dual_return = false;

@@ -31,7 +31,7 @@ bool worthLogging(std::int64_t n) {
 }  // namespace
 
 LidarPacketStream::LidarPacketStream(const LidarStreamConfig& config)
-    : clock_(config.clock), assembler_(config.sweep) {
+    : sensor_time_(config.clock.source == TimeSource::kSensor), clock_(config.clock), assembler_(config.sweep) {
   const std::array<double, kBeams> elevations = elevationTable(config);
   if (config.model == LidarModel::kVlp16) {
     auto decoder = std::make_shared<Vlp16Decoder>(elevations);
@@ -52,7 +52,8 @@ void LidarPacketStream::count(const std::string& counter, std::int64_t& total, c
 void LidarPacketStream::push(const std::uint8_t* data, std::size_t size, std::int64_t host_receive_ns,
                              std::vector<LidarScan>& sweeps) {
   ++health_.inputs;
-  const PacketStatus status = decode_(data, size, packet_);
+  PacketStatus status = decode_(data, size, packet_);
+  if (status == PacketStatus::kOk && !packet_.stamp_valid && sensor_time_) status = PacketStatus::kBadTimestamp;
   if (status != PacketStatus::kOk) {
     count(counterName(status), health_.errors,
           std::string(counterName(status)) + " (" + std::to_string(size) + " bytes)");

@@ -51,6 +51,7 @@ class LidarPacketStream {
   void syncSweepCounters();
 
   std::function<PacketStatus(const std::uint8_t*, std::size_t, DecodedPacket&)> decode_;
+  bool sensor_time_;
   PacketClock clock_;
   SweepAssembler assembler_;
   DecodedPacket packet_;  // reused between packets

@@ -48,7 +48,7 @@ PacketStatus Rs16Decoder::decode(const std::uint8_t* data, std::size_t size, Dec
   if (data == nullptr || size != kRs16PacketSize) return PacketStatus::kWrongSize;
   if (!std::equal(kRs16Magic.begin(), kRs16Magic.end(), data)) return PacketStatus::kBadMagic;
   std::int64_t stamp = 0;
-  if (!headerTime(data, stamp)) return PacketStatus::kBadTimestamp;
+  const bool stamp_valid = headerTime(data, stamp);
   const std::uint8_t* blocks = data + kRs16HeaderSize;
   std::uint16_t azimuth[kBlocks];
   for (int b = 0; b < kBlocks; ++b) {
@@ -58,6 +58,7 @@ PacketStatus Rs16Decoder::decode(const std::uint8_t* data, std::size_t size, Dec
     if (azimuth[b] >= 36000) return PacketStatus::kBadAzimuth;
   }
   out.stamp_us = stamp;
+  out.stamp_valid = stamp_valid;
 
   out.firings.reserve(static_cast<std::size_t>(kBlocks * 2 * kBeams));
   for (int b = 0; b < kBlocks; ++b) {

@@ -35,7 +35,8 @@ class Rs16Decoder {
  public:
   explicit Rs16Decoder(const std::array<double, kBeams>& elevation_deg = kRs16ElevationsDeg);
 
-  // Decodes one UDP payload into `out` (cleared first). Anything but kOk leaves `out` empty.
+  // Decodes one UDP payload into `out` (cleared first). Anything but kOk leaves `out` empty. A header time
+  // out of range (a sensor that never had its clock set) still decodes, with out.stamp_valid false.
   PacketStatus decode(const std::uint8_t* data, std::size_t size, DecodedPacket& out) const;
 
  private:

@@ -224,8 +224,11 @@ TEST(Decoders, MalformedPacketsAreRejectedWithTheirReason) {
   magic[3] = 0x0B;
   EXPECT_EQ(bad(Model::kRs16, magic), PacketStatus::kBadMagic);
   auto date = r;
-  date[21] = 13;  // month 13
-  EXPECT_EQ(bad(Model::kRs16, date), PacketStatus::kBadTimestamp);
+  date[21] = 13;  // month 13: decodes, but its stamp is flagged (the stream refuses it on sensor time)
+  EXPECT_EQ(bad(Model::kRs16, date), PacketStatus::kOk);
+  EXPECT_FALSE(d.stamp_valid);
+  EXPECT_EQ(bad(Model::kRs16, r), PacketStatus::kOk);
+  EXPECT_TRUE(d.stamp_valid);
   auto rflag = r;
   rflag[42 + 1100] = 0x00;  // block 11's flag
   EXPECT_EQ(bad(Model::kRs16, rflag), PacketStatus::kBadBlockFlag);

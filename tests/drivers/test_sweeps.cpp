@@ -269,6 +269,24 @@ TEST(SweepAssembler, MalformedPacketsInTheStreamChangeNothing) {
   }
 }
 
+TEST(PacketClock, Rs16WithoutAClockWorksOnHostTimeOnly) {
+  SyntheticLidar lidar;
+  lidar.model = Model::kRs16;
+  lidar.stamp0_us = testing::kRs16TestEpochUs;
+  const auto zeroDate = [](int, std::vector<std::uint8_t>& bytes, std::int64_t&) {
+    std::fill(bytes.begin() + 20, bytes.begin() + 30, 0);  // month 0, day 0: a clock never set
+  };
+  LidarStreamConfig config = streamConfig(lidar);
+  const StreamRun sensor = feed(lidar, range(kPackets), config, zeroDate);
+  EXPECT_TRUE(sensor.sweeps.empty());
+  EXPECT_EQ(sensor.health.counters.at("bad_timestamp"), kPackets);
+  EXPECT_EQ(sensor.health.errors, kPackets);
+  config.clock.source = TimeSource::kHost;
+  const StreamRun host = feed(lidar, range(kPackets), config, zeroDate);
+  EXPECT_EQ(host.sweeps.size(), 3u);
+  EXPECT_EQ(host.health.errors, 0);
+}
+
 TEST(SweepAssembler, LostPacketsDropTheSweepTheyHit) {
   SyntheticLidar lidar;
   std::vector<int> order;
