@@ -46,6 +46,14 @@ Eigen::Vector3f BeamTable::point(double range_m, double azimuth_deg, int laser) 
           static_cast<float>(range_m * sin_elevation[laser])};
 }
 
+void resetPacket(DecodedPacket& packet, SensorClock clock) {
+  std::vector<Firing> firings = std::move(packet.firings);
+  firings.clear();
+  packet = DecodedPacket{};
+  packet.clock = clock;
+  packet.firings = std::move(firings);
+}
+
 double wrapAzimuthCentiDeg(double centi_deg) {
   double a = std::fmod(centi_deg, 36000.0);
   if (a < 0) a += 36000.0;

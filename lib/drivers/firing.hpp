@@ -67,6 +67,9 @@ struct BeamTable {
   Eigen::Vector3f point(double range_m, double azimuth_deg, int laser) const;
 };
 
+// Empties `packet` for the next decode, keeping its firing buffer (no allocation per packet).
+void resetPacket(DecodedPacket& packet, SensorClock clock);
+
 // Wraps an azimuth in hundredths of a degree into [0, 36000).
 double wrapAzimuthCentiDeg(double centi_deg);
 

@@ -43,8 +43,7 @@ Rs16Decoder::Rs16Decoder(const std::array<double, kBeams>& elevation_deg)
     : beams_(BeamTable::fromElevationsDeg(elevation_deg)) {}
 
 PacketStatus Rs16Decoder::decode(const std::uint8_t* data, std::size_t size, DecodedPacket& out) const {
-  out = DecodedPacket{};
-  out.clock = SensorClock::kUtcMicros;
+  resetPacket(out, SensorClock::kUtcMicros);
   if (data == nullptr || size != kRs16PacketSize) return PacketStatus::kWrongSize;
   if (!std::equal(kRs16Magic.begin(), kRs16Magic.end(), data)) return PacketStatus::kBadMagic;
   std::int64_t stamp = 0;

@@ -21,8 +21,7 @@ Vlp16Decoder::Vlp16Decoder(const std::array<double, kBeams>& elevation_deg)
     : beams_(BeamTable::fromElevationsDeg(elevation_deg)) {}
 
 PacketStatus Vlp16Decoder::decode(const std::uint8_t* data, std::size_t size, DecodedPacket& out) const {
-  out = DecodedPacket{};
-  out.clock = SensorClock::kMicrosPastHour;
+  resetPacket(out, SensorClock::kMicrosPastHour);
   if (data == nullptr || size != kVlp16PacketSize) return PacketStatus::kWrongSize;
   const std::uint8_t mode = data[1204], product = data[1205];
   if (product != kVlp16ProductId && product != 0) return PacketStatus::kUnknownProduct;
