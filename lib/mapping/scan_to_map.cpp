@@ -24,9 +24,17 @@ std::vector<Eigen::Vector3d> transformed(const std::vector<Eigen::Vector3d>& poi
 
 }  // namespace
 
-MapperConfig mapperConfigFrom(const Config& c) {
+MapperConfig aloamMapperConfig() {
   MapperConfig m;
-  m.registration = registrationConfigFrom(c, "mapping");
+  m.registration.degeneracy_prior = false;
+  m.compensate_raw_sweeps = false;
+  m.registration.max_solver_iterations = 4;
+  return m;
+}
+
+MapperConfig mapperConfigFrom(const Config& c) {
+  MapperConfig m = c.get<bool>("ablation.aloam", false) ? aloamMapperConfig() : MapperConfig{};
+  m.registration = registrationConfigFrom(c, "mapping", m.registration);
   m.outer_iterations = c.get<int>("mapping.outer_iterations", m.outer_iterations);
   m.corner_resolution_m = c.get<double>("mapping.corner_resolution_m", m.corner_resolution_m);
   m.surf_resolution_m = c.get<double>("mapping.surf_resolution_m", m.surf_resolution_m);

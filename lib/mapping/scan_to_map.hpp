@@ -45,7 +45,12 @@ struct MapperConfig {
   bool compensate_raw_sweeps = true;
 };
 
-// Reads "mapping.*" keys with the defaults above.
+// Plain A-LOAM laserMapping behaviour for the ablation: no degeneracy prior, raw sweeps enter the map as they
+// are, 2 rounds of 4 iterations. (The local map stays a voxel hash: a data structure, not a behaviour.)
+MapperConfig aloamMapperConfig();
+
+// Reads "mapping.*" keys with the defaults above; with "ablation.aloam: true" the defaults are
+// aloamMapperConfig()'s (explicit mapping.* keys still override them).
 MapperConfig mapperConfigFrom(const Config& c);
 
 class ScanToMapMapper {

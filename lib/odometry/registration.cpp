@@ -74,8 +74,9 @@ void addDirectionalPriors(ceres::Problem& problem, double* xi, const DegeneracyR
 
 }  // namespace
 
-RegistrationConfig registrationConfigFrom(const Config& c, const std::string& prefix) {
-  RegistrationConfig r;
+RegistrationConfig registrationConfigFrom(const Config& c, const std::string& prefix,
+                                          const RegistrationConfig& defaults) {
+  RegistrationConfig r = defaults;
   const auto key = [&](const char* name) { return prefix + "." + name; };
   r.max_solver_iterations = c.get<int>(key("max_solver_iterations"), r.max_solver_iterations);
   r.loss = c.get<std::string>(key("loss"), r.loss);

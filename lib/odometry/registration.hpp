@@ -40,8 +40,9 @@ struct RegistrationConfig {
   double prior_sigma_rotation_rad = 0.01;
 };
 
-// Reads keys "<prefix>.max_solver_iterations", "<prefix>.loss", ... with the defaults above.
-RegistrationConfig registrationConfigFrom(const Config& c, const std::string& prefix);
+// Reads keys "<prefix>.max_solver_iterations", "<prefix>.loss", ...; missing keys keep `defaults`.
+RegistrationConfig registrationConfigFrom(const Config& c, const std::string& prefix,
+                                          const RegistrationConfig& defaults = {});
 
 struct RegistrationResult {
   bool ok = false;  // enough correspondences and a finite solution

@@ -22,9 +22,22 @@ Matrix6d priorCovariance(const RegistrationConfig& c) {
 
 }  // namespace
 
-ScanToScanConfig scanToScanConfigFrom(const Config& c) {
+ScanToScanConfig aloamOdometryConfig() {
   ScanToScanConfig s;
-  s.registration = registrationConfigFrom(c, "odometry");
+  s.registration.degeneracy_prior = false;
+  s.use_link3d_seed = false;
+  s.line_min_rings = 2;
+  s.three_point_planes = true;
+  s.compensate_mixed_deskew = false;
+  s.outer_iterations = 2;
+  s.registration.max_solver_iterations = 4;
+  s.max_match_distance_m = 5.0;
+  return s;
+}
+
+ScanToScanConfig scanToScanConfigFrom(const Config& c) {
+  ScanToScanConfig s = c.get<bool>("ablation.aloam", false) ? aloamOdometryConfig() : ScanToScanConfig{};
+  s.registration = registrationConfigFrom(c, "odometry", s.registration);
   s.outer_iterations = c.get<int>("odometry.outer_iterations", s.outer_iterations);
   s.max_match_distance_m = c.get<double>("odometry.max_match_distance_m", s.max_match_distance_m);
   s.ring_window = c.get<int>("odometry.ring_window", s.ring_window);
@@ -33,6 +46,7 @@ ScanToScanConfig scanToScanConfigFrom(const Config& c) {
   s.line_min_rings = c.get<int>("odometry.line_min_rings", s.line_min_rings);
   s.line_eigen_ratio = c.get<double>("odometry.line_eigen_ratio", s.line_eigen_ratio);
   s.line_max_point_distance_m = c.get<double>("odometry.line_max_point_distance_m", s.line_max_point_distance_m);
+  s.three_point_planes = c.get<bool>("odometry.three_point_planes", s.three_point_planes);
   s.ring_neighbours = c.get<int>("odometry.ring_neighbours", s.ring_neighbours);
   s.compensate_mixed_deskew = c.get<bool>("odometry.compensate_mixed_deskew", s.compensate_mixed_deskew);
   s.use_link3d_seed = c.get<bool>("odometry.use_link3d_seed", s.use_link3d_seed);
@@ -81,7 +95,21 @@ std::optional<LineFit> ScanToScanOdometry::fitLocalLine(const Eigen::Vector3d& q
   return line;
 }
 
+std::optional<PlaneFit> ScanToScanOdometry::threePointPlane(const Eigen::Vector3d& q, double max_sq) const {
+  const int j = prev_surfs_.nearest(q, max_sq);
+  if (j < 0) return std::nullopt;
+  const int ring = prev_surfs_.ring(j);
+  const int l = prev_surfs_.nearestInRing(ring, q, max_sq, j);
+  const int k = prev_surfs_.nearestInNeighbourRings(ring, config_.ring_window, q, max_sq);
+  if (l < 0 || k < 0) return std::nullopt;
+  const Eigen::Vector3d a = prev_surfs_.point(j), b = prev_surfs_.point(l), c = prev_surfs_.point(k);
+  const Eigen::Vector3d n = (b - a).cross(c - a);
+  if (n.norm() < 1e-9) return std::nullopt;
+  return PlaneFit{n.normalized(), -n.normalized().dot(a)};
+}
+
 std::optional<PlaneFit> ScanToScanOdometry::fitLocalPlane(const Eigen::Vector3d& q, double max_sq) const {
+  if (config_.three_point_planes) return threePointPlane(q, max_sq);
   // The nearest previous surface points, plus the nearest few on each neighbouring ring of the closest one:
   // a sparse sweep's nearest points often lie on one ring (collinear, so the plane's tilt about that line
   // would be noise). A-LOAM takes a single point from the neighbouring ring, which near a wall-floor junction

@@ -37,6 +37,9 @@ struct ScanToScanConfig {
   int plane_neighbours = 5;
   int ring_neighbours = 3;
   double plane_max_point_distance_m = 0.1;
+  // A-LOAM's plane instead: through the nearest point, its nearest on the same ring and the nearest on a
+  // neighbouring ring, unchecked (ablation only).
+  bool three_point_planes = false;
   // Accept a prior flagged kSeededByLinK3d as initial guess (false = A-LOAM ablation: motion model only).
   bool use_link3d_seed = true;
   // When exactly one of two consecutive sweeps arrives deskewed (start-up: the feature stage has no motion
@@ -47,7 +50,13 @@ struct ScanToScanConfig {
   double max_velocity_gap_s = 0.5;
 };
 
-// Reads "odometry.*" keys with the defaults above.
+// Plain A-LOAM laserOdometry behaviour, for the "before vs after" ablation: motion-model seed only (LinK3D
+// ignored), no degeneracy prior, A-LOAM's two-point lines and three-point planes, 2 rounds of 4 iterations,
+// 5 m matching radius, no compensation of raw sweeps.
+ScanToScanConfig aloamOdometryConfig();
+
+// Reads "odometry.*" keys with the defaults above. If "ablation.aloam" is true the defaults are those of
+// aloamOdometryConfig() (explicit odometry.* keys still override them).
 ScanToScanConfig scanToScanConfigFrom(const Config& c);
 
 class ScanToScanOdometry {
@@ -87,6 +96,7 @@ class ScanToScanOdometry {
   Refinement refine(const SweepPoints& cur, const Eigen::Isometry3d& seed, const Eigen::Isometry3d& hold) const;
   void setPrevious(const SweepPoints& points);
   std::optional<LineFit> fitLocalLine(const Eigen::Vector3d& q, double max_sq) const;
+  std::optional<PlaneFit> threePointPlane(const Eigen::Vector3d& q, double max_sq) const;
   std::optional<PlaneFit> fitLocalPlane(const Eigen::Vector3d& q, double max_sq) const;
 
   ScanToScanConfig config_;

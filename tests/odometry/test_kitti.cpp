@@ -33,12 +33,14 @@ MapperConfig kittiMapperConfig() {
   return m;
 }
 
-PairErrors runSequence(const std::string& name, bool use_link3d) {
+PairErrors runSequence(const std::string& name, bool aloam) {
   const io::KittiSequence seq = io::KittiSequence::open(kRoot, name);
   const Trajectory gt = seq.groundTruthLidar(seq.defaultPosesFile());
   const FeatureExtractor fx{FeatureConfig{}};
-  ScanToScanOdometry odom;
-  ScanToMapMapper mapper(kittiMapperConfig());
+  ScanToScanOdometry odom(aloam ? aloamOdometryConfig() : ScanToScanConfig{});
+  MapperConfig mc = kittiMapperConfig();
+  if (aloam) mc.registration.degeneracy_prior = false, mc.compensate_raw_sweeps = false;
+  ScanToMapMapper mapper(mc);
   PairErrors errors;
   FeatureSet previous;
   std::vector<PoseEstimate> odo, map;
@@ -48,12 +50,12 @@ PairErrors runSequence(const std::string& name, bool use_link3d) {
     if (i > 0) {
       motion.T_prev_curr = odom.predictMotion(scan.utime);
       motion.dt_s = toSeconds(scan.utime - seq.utime(i - 1));
-      motion.valid = i > 1;  // scans 0 and 1 arrive raw: no velocity yet (the odometry compensates)
+      motion.valid = i > 1 && !aloam;  // scans 0 and 1 arrive raw: no velocity yet (the odometry compensates)
     }
     const FeatureSet f = fx.process(scan, {}, motion);
     std::optional<Eigen::Isometry3d> seed;
     int seed_flags = 0;
-    if (i > 0 && use_link3d) {
+    if (i > 0) {  // the ablation's odometry ignores this seed (use_link3d_seed = false)
       const auto matches = matchLinK3d(previous, f, fx.config().link3d);
       const RansacResult r = estimateTransformRansac(previous.keypoints, f.keypoints, matches, fx.config().ransac);
       if (r.ok) seed = r.T_a_b, seed_flags = PoseEstimate::kSeededByLinK3d;
@@ -87,7 +89,7 @@ class KittiOdometry : public ::testing::TestWithParam<const char*> {};
 // Measured: 01 worst 0.066 m / 0.23 deg (odometry), 0.047 m / 0.13 deg (mapping); 02 worst 0.054 m / 0.21 deg
 // and 0.053 m / 0.12 deg.
 TEST_P(KittiOdometry, RelativePoseErrorPerPairIsSmall) {
-  const PairErrors e = runSequence(GetParam(), true);
+  const PairErrors e = runSequence(GetParam(), false);
   std::printf("%s worst: odometry %.3f m %.3f deg, mapping %.3f m %.3f deg; LinK3D-seeded %d/9\n", GetParam(),
               worst(e.odom_t), worst(e.odom_r), worst(e.map_t), worst(e.map_r), e.seeded_by_link3d);
   EXPECT_EQ(e.failed, 0);
@@ -109,7 +111,7 @@ INSTANTIATE_TEST_SUITE_P(Sequences, KittiOdometry, ::testing::Values("01", "02")
 // its mean at 0.25 deg. Measured: worst 0.18 m / 0.35 deg (odometry), 0.18 m / 0.30 deg (mapping), mean
 // rotation 0.23 deg.
 TEST(KittiOdometry, Sequence00) {
-  const PairErrors e = runSequence("00", true);
+  const PairErrors e = runSequence("00", false);
   std::printf("00 worst: odometry %.3f m %.3f deg, mapping %.3f m %.3f deg; LinK3D-seeded %d/9\n", worst(e.odom_t),
               worst(e.odom_r), worst(e.map_t), worst(e.map_r), e.seeded_by_link3d);
   EXPECT_EQ(e.failed, 0);
@@ -125,6 +127,24 @@ TEST(KittiOdometry, Sequence00) {
   }
   EXPECT_LT(mean_odom_r, 0.25);
   EXPECT_LT(mean_map_r, 0.25);
+}
+
+// The A-LOAM ablation (no LinK3D seed, no deskew, A-LOAM lines and planes, no degeneracy prior) is the
+// "before" of the comparison: it must run and track, not excel. Without a seed its first pairs start from
+// zero motion at 1-1.5 m per scan and need ~3 scans to catch up (measured 02: 0.78, 0.33 m on pairs 0-1 and
+// 1-2 after mapping, where the seeded pipeline errs 0.02 m); from pair 3 on it is judged at 0.1 m / 0.3 deg.
+TEST(KittiOdometry, AloamAblationTracksAfterStartUp) {
+  for (const char* name : {"01", "02"}) {
+    const PairErrors e = runSequence(name, true);
+    std::printf("%s A-LOAM ablation worst: odometry %.3f m %.3f deg, mapping %.3f m %.3f deg; seeded %d\n", name,
+                worst(e.odom_t), worst(e.odom_r), worst(e.map_t), worst(e.map_r), e.seeded_by_link3d);
+    EXPECT_EQ(e.seeded_by_link3d, 0);
+    EXPECT_EQ(e.failed, 0);
+    for (std::size_t i = 3; i < e.map_t.size(); ++i) {
+      EXPECT_LT(e.map_t[i], 0.1) << name << " pair " << i;
+      EXPECT_LT(e.map_r[i], 0.3) << name << " pair " << i;
+    }
+  }
 }
 
 }  // namespace
