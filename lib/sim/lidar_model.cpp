@@ -135,11 +135,19 @@ LidarScan LidarSimulator::simulate(LocalRayCaster& caster, const PoseAt& pose_at
       const Eigen::Matrix3d dR = pose_a.linear().transpose() * pose_b.linear();
       phi = 0.5 * Eigen::Vector3d(dR(2, 1) - dR(1, 2), dR(0, 2) - dR(2, 0), dR(1, 0) - dR(0, 1)).cast<float>();
     }
-    // Range noise for the whole sequence: Box-Muller pairs (a fixed number of draws per column).
+    // Range noise for the whole sequence: Marsaglia's polar method gives normal pairs without sin/cos. Its
+    // rejection loop depends only on the random numbers, never on the geometry, so a sweep's noise stays the
+    // same firing for firing whatever the poses.
     for (int j = 0; j < J; j += 2) {
-      const double r = std::sqrt(-2.0 * std::log(1.0 - rng.uniform())), a = 2.0 * M_PI * rng.uniform();
-      noise[j] = static_cast<float>(r * std::cos(a));
-      noise[j + 1] = static_cast<float>(r * std::sin(a));
+      double x, y, r2;
+      do {
+        x = 2.0 * rng.uniform() - 1.0;
+        y = 2.0 * rng.uniform() - 1.0;
+        r2 = x * x + y * y;
+      } while (r2 >= 1.0 || r2 == 0.0);
+      const double f = std::sqrt(-2.0 * std::log(r2) / r2);
+      noise[j] = static_cast<float>(x * f);
+      noise[j + 1] = static_cast<float>(y * f);
     }
     const float column_dt = static_cast<float>((c - (C - 1)) * period);
     const float column_sigma = static_cast<float>((c % kPoseStride) * period / span);

@@ -346,12 +346,13 @@ int Scene::buildNode(std::vector<Eigen::AlignedBox3f>& boxes, std::vector<Eigen:
   return index;
 }
 
-Hit Scene::intersect(const Ray& ray, float t_min) const {
+Hit Scene::intersect(const Ray& ray, float t_min) const { return intersect(ray, t_min, safeInverse(ray.dir)); }
+
+Hit Scene::intersect(const Ray& ray, float t_min, const Eigen::Vector3f& inv) const {
   Hit hit;
   hit.t = ray.t_max;
   if (nodes4_.empty()) return Hit{};
   // Slab test as t = bound * inv - origin * inv, four child boxes at once.
-  const Eigen::Vector3f inv = safeInverse(ray.dir);
   const float oi[3] = {ray.origin.x() * inv.x(), ray.origin.y() * inv.y(), ray.origin.z() * inv.z()};
   struct Pending {
     std::int32_t child, count;
@@ -455,20 +456,21 @@ void LocalRayCaster::moveTo(const Eigen::Vector3f& position) {
 }
 
 Hit LocalRayCaster::intersect(const Ray& ray, float t_min) const {
-  if (!region_.contains(ray.origin)) return scene_->intersect(ray, t_min);
+  const Eigen::Vector3f inv = safeInverse(ray.dir);
+  if (!region_.contains(ray.origin)) return scene_->intersect(ray, t_min, inv);
   // Distance at which the ray leaves the crop region.
   float t_exit = std::numeric_limits<float>::infinity();
   for (int a = 0; a < 3; ++a) {
-    if (ray.dir[a] > 0.0f) t_exit = std::min(t_exit, (region_.max()[a] - ray.origin[a]) / ray.dir[a]);
-    if (ray.dir[a] < 0.0f) t_exit = std::min(t_exit, (region_.min()[a] - ray.origin[a]) / ray.dir[a]);
+    const float bound = ray.dir[a] > 0.0f ? region_.max()[a] : region_.min()[a];
+    t_exit = std::min(t_exit, (bound - ray.origin[a]) * inv[a]);
   }
   Ray local_ray = ray;
   local_ray.t_max = std::min(ray.t_max, t_exit);
-  const Hit hit = local_.intersect(local_ray, t_min);
+  const Hit hit = local_.intersect(local_ray, t_min, inv);
   // A hit inside the region is the nearest: anything nearer lies in the region, hence in the crop.
   if (hit.valid() || t_exit >= ray.t_max) return hit;
   // Nothing before the exit: only hits beyond it remain (a small overlap guards against rounding).
-  return scene_->intersect(ray, std::max(t_min, t_exit - 1e-3f));
+  return scene_->intersect(ray, std::max(t_min, t_exit - 1e-3f), inv);
 }
 
 }  // namespace adit::sim

@@ -102,6 +102,9 @@ class Scene {
     Eigen::Vector3f a, normal, bu, bv;  // normal unit; u = (p - a).bu, v = (p - a).bv
   };
 
+  friend class LocalRayCaster;
+  // intersect() with the ray's component-wise inverse direction already computed.
+  Hit intersect(const Ray& ray, float t_min, const Eigen::Vector3f& inv) const;
   Eigen::AlignedBox3f refBounds(const Ref& r) const;
   int collapse(int binary_node);
   bool intersectRef(const Ref& r, const Ray& ray, float t_min, Hit& hit) const;

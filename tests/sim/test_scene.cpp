@@ -75,7 +75,7 @@ TEST(Scene, BvhMatchesBruteForceOnRandomScene) {
   }
   scene.build();
   int hits = 0;
-  for (int i = 0; i < 20000; ++i) {
+  for (int i = 0; i < 6000; ++i) {
     const Ray ray = makeRay(rnd(35.0), rnd(1.0), 80.0f);
     const Hit fast = scene.intersect(ray), slow = scene.intersectBruteForce(ray);
     ASSERT_EQ(fast.valid(), slow.valid()) << "ray " << i;
@@ -83,7 +83,7 @@ TEST(Scene, BvhMatchesBruteForceOnRandomScene) {
     ++hits;
     EXPECT_EQ(fast.t, slow.t) << "ray " << i;  // same primitive test: bit-identical distance
   }
-  EXPECT_GT(hits, 1000);  // the comparison is not vacuous
+  EXPECT_GT(hits, 300);  // the comparison is not vacuous
 }
 
 TEST(Scene, LocalCropAnswersLikeTheWholeScene) {
