@@ -82,23 +82,46 @@ ScanToMapMapper::Sweep ScanToMapMapper::prepare(const FeatureSet& f) const {
   s.corners = f.corner_less_sharp;
   s.surfs = f.surf_less_flat;
   s.cloud = f.cloud.points;
+  downsample(s);
   return s;
+}
+
+void ScanToMapMapper::downsample(Sweep& s) const {
+  s.corner_points = voxelDownsample(toDouble(s.corners), config_.corner_resolution_m);
+  s.surf_points = voxelDownsample(toDouble(s.surfs), config_.surf_resolution_m);
 }
 
 void ScanToMapMapper::compensate(Sweep& s, const Eigen::Isometry3d& T_prev_curr, double gap_s) const {
   for (auto* v : {&s.corners, &s.surfs, &s.cloud}) compensateMotion(*v, T_prev_curr, gap_s);
   s.raw = false;
+  downsample(s);
 }
 
 void ScanToMapMapper::addToMaps(const Sweep& s, const Eigen::Isometry3d& T) {
-  corner_map_.insert(transformed(voxelDownsample(toDouble(s.corners), config_.corner_resolution_m), T));
-  surf_map_.insert(transformed(voxelDownsample(toDouble(s.surfs), config_.surf_resolution_m), T));
+  corner_map_.insert(transformed(s.corner_points, T));
+  surf_map_.insert(transformed(s.surf_points, T));
   corner_map_.removeFarFrom(T.translation(), config_.local_map_radius_m);
   surf_map_.removeFarFrom(T.translation(), config_.local_map_radius_m);
   std::vector<Eigen::Vector3f> cloud;
   cloud.reserve(s.cloud.size());
   for (const LidarPoint& p : s.cloud) cloud.push_back(p.p);
   global_map_.insert(cloud, T, config_.global_map_max_range_m);
+}
+
+ScanToMapMapper::Refinement ScanToMapMapper::refine(const Sweep& sweep, const Eigen::Isometry3d& predicted,
+                                                     int& iterations) const {
+  Refinement out;
+  out.pose = predicted;
+  for (int round = 0; round < std::max(1, config_.outer_iterations); ++round) {
+    out.result = registerStep(match(sweep.corner_points, sweep.surf_points, out.pose), out.pose, predicted,
+                              config_.registration);
+    iterations += out.result.iterations;
+    if (!(out.ok = out.result.ok)) break;
+    const bool converged = hasConverged(out.pose, out.result.pose);
+    out.pose = out.result.pose;
+    if (converged) break;
+  }
+  return out;
 }
 
 PoseEstimate ScanToMapMapper::process(const FeatureSet& f, const PoseEstimate& odometry) {
@@ -122,33 +145,18 @@ PoseEstimate ScanToMapMapper::process(const FeatureSet& f, const PoseEstimate& o
     pending_.reset();
   }
 
-  const auto corners = voxelDownsample(toDouble(sweep.corners), config_.corner_resolution_m);
-  const auto surfs = voxelDownsample(toDouble(sweep.surfs), config_.surf_resolution_m);
-  const bool first = corner_map_.empty() && surf_map_.empty();
+  const bool first = !has_previous_;  // nothing to register against yet (later, an empty map is a failure)
   Eigen::Isometry3d T = predicted;
-  bool ok = !first;
-  RegistrationResult r;
-  for (int round = 0; ok && round < std::max(1, config_.outer_iterations); ++round) {
-    r = registerStep(match(corners, surfs, T), T, predicted, config_.registration);
-    ok = r.ok;
-    out.iterations += r.iterations;
-    if (!ok) break;
-    const bool converged = hasConverged(T, r.pose);
-    T = r.pose;
-    if (converged) break;
+  if (!first) {
+    const Refinement r = refine(sweep, predicted, out.iterations);
+    if (r.ok) {
+      T = r.pose;
+      reportRegistration(r.result, config_.registration, out);
+    } else {
+      out.flags |= PoseEstimate::kRegistrationFailed;
+    }
   }
-  if (ok) {
-    out.covariance = covarianceFrom(r.information, r.degeneracy, config_.registration.prior_sigma_translation_m,
-                                    config_.registration.prior_sigma_rotation_rad);
-    out.translation_eigenvalues = r.degeneracy.translation_eigenvalues;
-    out.rotation_eigenvalues = r.degeneracy.rotation_eigenvalues;
-    out.flags |= r.degeneracy.flags;
-    out.final_cost = r.final_cost;
-  } else {
-    T = predicted;
-    out.covariance = odometry.covariance;
-    if (!first) out.flags |= PoseEstimate::kRegistrationFailed;
-  }
+  if (first || (out.flags & PoseEstimate::kRegistrationFailed)) out.covariance = odometry.covariance;
   T_map_odom_ = T * odom.inverse();
   if (config_.compensate_raw_sweeps && sweep.raw && !have_motion) {
     pending_ = std::move(sweep);

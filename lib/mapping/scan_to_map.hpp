@@ -81,8 +81,17 @@ class ScanToMapMapper {
     std::int64_t utime = 0;
     bool raw = false;
     std::vector<LidarPoint> corners, surfs, cloud;
+    std::vector<Eigen::Vector3d> corner_points, surf_points;  // downsampled corners / surfs
   };
+  struct Refinement {
+    bool ok = false;
+    Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+    RegistrationResult result;  // of the last round
+  };
+  // Correspondence rounds against the local map from the prediction (which also holds degenerate directions).
+  Refinement refine(const Sweep& sweep, const Eigen::Isometry3d& predicted, int& iterations) const;
   Sweep prepare(const FeatureSet& f) const;
+  void downsample(Sweep& s) const;
   void compensate(Sweep& s, const Eigen::Isometry3d& T_prev_curr, double gap_s) const;
   void addToMaps(const Sweep& s, const Eigen::Isometry3d& T_world_lidar);
 

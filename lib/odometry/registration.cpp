@@ -134,4 +134,13 @@ RegistrationResult registerStep(const Correspondences& matches, const Eigen::Iso
   return result;
 }
 
+void reportRegistration(const RegistrationResult& r, const RegistrationConfig& config, PoseEstimate& out) {
+  out.covariance = covarianceFrom(r.information, r.degeneracy, config.prior_sigma_translation_m,
+                                  config.prior_sigma_rotation_rad);
+  out.translation_eigenvalues = r.degeneracy.translation_eigenvalues;
+  out.rotation_eigenvalues = r.degeneracy.rotation_eigenvalues;
+  out.flags |= r.degeneracy.flags;
+  out.final_cost = r.final_cost;
+}
+
 }  // namespace adit

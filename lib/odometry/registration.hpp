@@ -59,4 +59,8 @@ struct RegistrationResult {
 RegistrationResult registerStep(const Correspondences& matches, const Eigen::Isometry3d& T0,
                                 const Eigen::Isometry3d& motion_prior, const RegistrationConfig& config);
 
+// Copies a successful result's covariance (degenerate directions inflated to the prior), eigenvalues,
+// degeneracy flags and cost into `out`.
+void reportRegistration(const RegistrationResult& result, const RegistrationConfig& config, PoseEstimate& out);
+
 }  // namespace adit

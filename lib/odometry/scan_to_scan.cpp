@@ -213,13 +213,7 @@ PoseEstimate ScanToScanOdometry::process(const FeatureSet& f, const std::optiona
   out.iterations = r.iterations;
   Eigen::Isometry3d T = r.pose;
   if (has_previous_ && r.ok) {
-    out.covariance = covarianceFrom(r.result.information, r.result.degeneracy,
-                                    config_.registration.prior_sigma_translation_m,
-                                    config_.registration.prior_sigma_rotation_rad);
-    out.translation_eigenvalues = r.result.degeneracy.translation_eigenvalues;
-    out.rotation_eigenvalues = r.result.degeneracy.rotation_eigenvalues;
-    out.flags |= r.result.degeneracy.flags;
-    out.final_cost = r.result.final_cost;
+    reportRegistration(r.result, config_.registration, out);
   } else {
     T = seed;
     out.covariance = priorCovariance(config_.registration);
