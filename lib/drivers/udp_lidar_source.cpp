@@ -51,6 +51,7 @@ class UdpLidarSource : public runtime::MessageSource {
             spdlog::info("no lidar packet for {} s: stopping", idle_timeout_.count());
             return false;
           }
+          idle();
           break;
         case UdpReceiver::Result::kError:
           receive_errors_ += 1;

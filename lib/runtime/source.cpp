@@ -48,6 +48,9 @@ int publishLive(MessageSource& source, const SourceRunOptions& options) {
     published_at_last_status = published;
   };
 
+  source.setIdleHook([&] {
+    if (Clock::now() - last_status >= std::chrono::duration<double>(options.status_period_s)) sendStatus("waiting");
+  });
   // Sensor time t maps to wall time: start + (t - t0) / rate.
   std::int64_t t0 = -1;
   OutgoingMessage m;
@@ -66,6 +69,7 @@ int publishLive(MessageSource& source, const SourceRunOptions& options) {
     ++published;
     if (Clock::now() - last_status >= std::chrono::duration<double>(options.status_period_s)) sendStatus("running");
   }
+  source.setIdleHook({});
   sendStatus("stopping");
   const Health& h = source.health();
   spdlog::info("published {} messages ({} errors, {} skipped)", published, h.errors, h.drops);

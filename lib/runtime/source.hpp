@@ -6,6 +6,7 @@
 #include "runtime/health.hpp"
 #include "runtime/node.hpp"
 
+#include <functional>
 #include <string>
 
 namespace adit::runtime {
@@ -22,6 +23,18 @@ class MessageSource {
   // Next message in time order; false at the end. Recoverable problems are counted in health().
   virtual bool next(OutgoingMessage& message) = 0;
   virtual const Health& health() const = 0;
+
+  // A source that waits for input (a live sensor) calls the hook about every 100 ms while nothing
+  // arrives, so the runner keeps publishing STATUS while the sensor is silent.
+  void setIdleHook(std::function<void()> hook) { idle_hook_ = std::move(hook); }
+
+ protected:
+  void idle() const {
+    if (idle_hook_) idle_hook_();
+  }
+
+ private:
+  std::function<void()> idle_hook_;
 };
 
 struct SourceRunOptions {

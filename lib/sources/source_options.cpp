@@ -1,24 +1,41 @@
 #include "sources/source_options.hpp"
 
+#include "drivers/udp_lidar_source.hpp"
+#include "runtime/process.hpp"
 #include "sources/file_sources.hpp"
 
 namespace adit::sources {
 
 void addLidarSourceOptions(CLI::App& app, LidarSourceArgs& a, bool kind_positional) {
-  const auto kinds = CLI::IsMember({"kitti", "pcd"});
-  if (kind_positional)
-    app.add_option("kind", a.kind, "Data set kind: kitti | pcd")->required()->check(kinds);
-  else
-    app.add_option("--source", a.kind, "Data set kind: kitti | pcd")->required()->check(kinds);
-  app.add_option(kind_positional ? "path" : "--path", a.path,
-                 "KITTI sequence folder (sequences/NN) or folder of PCD files")->required()->check(CLI::ExistingDirectory);
+  if (kind_positional) {
+    app.add_option("kind", a.kind, "Data set kind: kitti | pcd")->required()->check(CLI::IsMember({"kitti", "pcd"}));
+    app.add_option("path", a.path, "KITTI sequence folder (sequences/NN) or folder of PCD files")
+        ->required()->check(CLI::ExistingDirectory);
+  } else {
+    app.add_option("--source", a.kind, "kitti | pcd (recorded files) or vlp16 | rs16 (live sensor packets over UDP)")
+        ->required()->check(CLI::IsMember({"kitti", "pcd", "vlp16", "rs16"}));
+    app.add_option("--path", a.path, "kitti/pcd: KITTI sequence folder (sequences/NN) or folder of PCD files")
+        ->check(CLI::ExistingDirectory);
+    app.add_option("--driver-config", a.driver_configs, "vlp16/rs16: YAML with lidar_driver.* keys (launch/sensors/)");
+    app.add_option("--port", a.port, "vlp16/rs16: UDP data port (default 2368 / 6699)");
+  }
   app.add_option("--channel", a.channel, "Channel of the sweeps");
   app.add_option("--sensor", a.sensor, "PCD: sensor profile for rings by elevation (vlp16, rs16, hdl64)");
   app.add_option("--beams", a.beams, "PCD: beam count for a uniform fan when the profile is unknown");
   app.add_option("--period", a.period_s, "PCD: sweep period (s) when file names are not timestamps");
 }
 
+bool isLiveSource(const LidarSourceArgs& a) { return a.kind == "vlp16" || a.kind == "rs16"; }
+
 std::unique_ptr<runtime::MessageSource> makeLidarSource(const LidarSourceArgs& a) {
+  if (isLiveSource(a)) {
+    drivers::UdpLidarConfig config = drivers::udpLidarConfigFrom(runtime::loadConfig(a.driver_configs));
+    config.model = a.kind;
+    config.channel = a.channel;
+    if (a.port > 0) config.port = a.port;
+    return drivers::makeUdpLidarSource(config);
+  }
+  if (a.path.empty()) throw std::runtime_error("--path is required for a " + a.kind + " source");
   if (a.kind == "kitti") return makeKittiSource(a.path, a.channel);
   if (a.kind == "pcd") {
     io::PcdFolderConfig config;

@@ -11,8 +11,10 @@
 namespace adit::sources {
 
 struct LidarSourceArgs {
-  std::string kind;   // "kitti" or "pcd"
+  std::string kind;   // "kitti", "pcd" (recorded) or "vlp16", "rs16" (live UDP packets)
   std::string path;   // sequence folder or PCD folder
+  std::vector<std::string> driver_configs;  // live: YAML with lidar_driver.* keys
+  int port = 0;                              // live: UDP port (0 = the sensor's default)
   std::string channel = "LIDAR_POINTS";
   // PCD only: sensor profile for rings by elevation when the files have no ring field.
   std::string sensor = "vlp16";
@@ -22,7 +24,8 @@ struct LidarSourceArgs {
 
 // kind_positional: `adit import kitti <dir>` takes the kind as a positional; the bridge uses --source.
 void addLidarSourceOptions(CLI::App& app, LidarSourceArgs& args, bool kind_positional);
-// Throws std::runtime_error (unknown kind, unreadable folder).
+bool isLiveSource(const LidarSourceArgs& args);
+// Throws std::runtime_error (unknown kind, unreadable folder, socket that cannot be bound).
 std::unique_ptr<runtime::MessageSource> makeLidarSource(const LidarSourceArgs& args);
 
 }  // namespace adit::sources

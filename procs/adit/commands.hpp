@@ -8,6 +8,7 @@
 void registerImportCommand(CLI::App& app);
 void registerInfoCommand(CLI::App& app);
 void registerConfigCommand(CLI::App& app);
+void registerSimCommand(CLI::App& app);
 void registerReplayCommand(CLI::App& app);
 void registerLaunchCommand(CLI::App& app);
 void registerSpyCommand(CLI::App& app);

@@ -19,6 +19,7 @@ int main(int argc, char** argv) {
   registerImportCommand(app);
   registerInfoCommand(app);
   registerConfigCommand(app);
+  registerSimCommand(app);
   registerReplayCommand(app);
   registerLaunchCommand(app);
   registerSpyCommand(app);

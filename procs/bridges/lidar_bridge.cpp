@@ -1,5 +1,5 @@
-// adit-lidar-bridge: publishes recorded sweeps (KITTI layout or a PCD folder) on LIDAR_POINTS at the
-// recorded rate (or --rate times it), or writes them straight into an LCM log with -o.
+// adit-lidar-bridge: publishes sweeps on LIDAR_POINTS: live from a VLP-16 / RS-16 (UDP packets), or
+// recorded (KITTI layout, PCD folder) at the recorded rate (or --rate times it); -o writes an LCM log instead.
 #include "runtime/process.hpp"
 #include "runtime/source.hpp"
 #include "sources/source_options.hpp"
@@ -20,6 +20,7 @@ int main(int argc, char** argv) {
   spdlog::set_pattern("%H:%M:%S.%e %^%l%$ adit-lidar-bridge: %v");
   try {
     auto src = adit::sources::makeLidarSource(source);
+    if (adit::sources::isLiveSource(source)) run.rate = 0;  // a sensor paces itself
     return adit::runtime::runSource(*src, run);
   } catch (const std::exception& e) {
     spdlog::error("{}", e.what());

@@ -1,0 +1,51 @@
+#include "sources/sim_source.hpp"
+
+#include "msg/convert.hpp"
+
+namespace adit::sources {
+namespace {
+
+template <class Msg>
+runtime::Bytes encode(Msg& m) {
+  runtime::Bytes bytes(static_cast<std::size_t>(m.getEncodedSize()));
+  m.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
+  return bytes;
+}
+
+}  // namespace
+
+SimSource::SimSource(const sim::SimConfig& config, SimChannels channels)
+    : simulator_(config), channels_(std::move(channels)) {}
+
+bool SimSource::next(runtime::OutgoingMessage& out) {
+  if (pending_truth_) {
+    out = std::move(*pending_truth_);
+    pending_truth_.reset();
+    ++health_.outputs;
+    return true;
+  }
+  sim::SimEvent event;
+  if (!simulator_.next(event)) return false;
+  if (event.kind == sim::SimEvent::Kind::Scan) {
+    adit::point_cloud_t m = msg::toMessage(event.scan);
+    out = {channels_.lidar, encode(m), event.scan.utime};
+    truth_.push_back(event.truth);
+    if (!channels_.ground_truth.empty()) {
+      PoseEstimate truth;
+      truth.utime = event.truth.utime;
+      truth.pose = event.truth.pose;
+      truth.covariance.setZero();
+      adit::odometry_t t = msg::toMessage(truth, nullptr);
+      t.header.seq = truth_seq_++;
+      pending_truth_ = runtime::OutgoingMessage{channels_.ground_truth, encode(t), truth.utime};
+    }
+  } else {
+    adit::imu_t m = msg::toMessage(event.imu);
+    m.header.seq = imu_seq_++;
+    out = {channels_.imu, encode(m), event.imu.utime};
+  }
+  ++health_.outputs;
+  return true;
+}
+
+}  // namespace adit::sources

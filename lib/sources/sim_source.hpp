@@ -1,0 +1,38 @@
+// The roadway simulator as a message source: LIDAR_POINTS, IMU and GROUND_TRUTH in time order, for
+// `adit sim` (to a log, or live over LCM). Keeps the ground-truth poses of the sweeps for the --gt file.
+#pragma once
+
+#include "core/types.hpp"
+#include "runtime/source.hpp"
+#include "sim/simulator.hpp"
+
+#include <memory>
+
+namespace adit::sources {
+
+struct SimChannels {
+  std::string lidar = "LIDAR_POINTS";
+  std::string imu = "IMU";
+  std::string ground_truth = "GROUND_TRUTH";  // "" = do not publish
+};
+
+class SimSource : public runtime::MessageSource {
+ public:
+  SimSource(const sim::SimConfig& config, SimChannels channels);
+  bool next(runtime::OutgoingMessage& message) override;
+  const runtime::Health& health() const override { return health_; }
+
+  const sim::Simulator& simulator() const { return simulator_; }
+  // T_world_lidar at each sweep's utime (its last firing), in the order published.
+  const Trajectory& groundTruth() const { return truth_; }
+
+ private:
+  sim::Simulator simulator_;
+  SimChannels channels_;
+  runtime::Health health_;
+  Trajectory truth_;
+  std::optional<runtime::OutgoingMessage> pending_truth_;  // published right after its sweep
+  std::int64_t imu_seq_ = 0, truth_seq_ = 0;
+};
+
+}  // namespace adit::sources
