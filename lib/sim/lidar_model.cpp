@@ -96,6 +96,83 @@ LidarScan LidarSimulator::simulate(const Scene& scene, const PoseAt& pose_at, do
   return simulate(caster, pose_at, t_end, utime, seq, seed);
 }
 
+namespace {
+
+// Normal deviates in pairs by Marsaglia's polar method (no sin/cos). Its rejection loop depends only on the
+// random numbers, never on the geometry, so a sweep's noise stays the same firing for firing whatever the poses.
+void normalPairs(Rng& rng, float* out, int count) {
+  for (int j = 0; j < count; j += 2) {
+    double x, y, r2;
+    do {
+      x = 2.0 * rng.uniform() - 1.0;
+      y = 2.0 * rng.uniform() - 1.0;
+      r2 = x * x + y * y;
+    } while (r2 >= 1.0 || r2 == 0.0);
+    const double f = std::sqrt(-2.0 * std::log(r2) / r2);
+    out[j] = static_cast<float>(x * f);
+    out[j + 1] = static_cast<float>(y * f);
+  }
+}
+
+// Sensor motion over a block of firing sequences: exact poses at both ends, first order in between.
+struct PoseBlock {
+  Eigen::Matrix3f R = Eigen::Matrix3f::Identity();
+  Eigen::Vector3f p = Eigen::Vector3f::Zero(), dp = Eigen::Vector3f::Zero(), phi = Eigen::Vector3f::Zero();
+
+  PoseBlock() = default;
+  PoseBlock(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b)
+      : R(a.linear().cast<float>()),
+        p(a.translation().cast<float>()),
+        dp((b.translation() - a.translation()).cast<float>()) {
+    const Eigen::Matrix3d dR = a.linear().transpose() * b.linear();
+    phi = 0.5 * Eigen::Vector3d(dR(2, 1) - dR(1, 2), dR(0, 2) - dR(2, 0), dR(1, 0) - dR(0, 1)).cast<float>();
+  }
+  // World ray of sensor direction d at fraction s in [0, 1] of the block (unit to ~1e-9: tiny rotation step).
+  Ray ray(const Eigen::Vector3f& d, float s, float t_max) const {
+    Ray r;
+    r.origin = p + s * dp;
+    r.dir = R * (d + s * phi.cross(d));
+    r.t_max = t_max;
+    return r;
+  }
+};
+
+float uniform16(std::uint64_t bits, int k) {
+  return (static_cast<float>((bits >> (16 * k)) & 0xFFFF) + 0.5f) * (1.0f / 65536.0f);
+}
+
+}  // namespace
+
+bool LidarSimulator::measure(const Hit& hit, const Ray& ray, float noise, std::uint64_t bits, float& range,
+                             float& intensity) const {
+  const float min_range = static_cast<float>(profile_.min_range), max_range = static_cast<float>(profile_.max_range);
+  range = 0.0f;
+  // Dust: a return from a particle in front of the surface (bits: 16-bit uniforms 1 and 2; 3 = intensity).
+  if (!noise_.noiseless && noise_.dust && uniform16(bits, 1) < noise_.dust_probability) {
+    const float r_dust = min_range - static_cast<float>(noise_.dust_mean_range) * std::log(1.0f - uniform16(bits, 2));
+    if (!hit.valid() || r_dust < hit.t) {
+      range = r_dust;
+      intensity = 2.0f + 6.0f * uniform16(bits, 3);
+    }
+  }
+  if (range == 0.0f) {
+    if (!hit.valid()) return false;
+    const float cos_incidence = std::fabs(hit.normal.dot(ray.dir));
+    if (!noise_.noiseless) {  // dropouts: everywhere, at grazing incidence, dark surfaces far away (uniform 0)
+      const float grazing = std::max(0.0f, 1.0f - cos_incidence / static_cast<float>(std::sin(10.0 * kDeg)));
+      const float far = hit.t / max_range;
+      const float p_drop = static_cast<float>(noise_.dropout + noise_.grazing_dropout * grazing +
+                                              noise_.dark_dropout * (1.0f - hit.reflectivity) * far * far);
+      if (uniform16(bits, 0) < p_drop) return false;
+    }
+    range = noise_.noiseless ? hit.t : hit.t + static_cast<float>(profile_.range_sigma) * noise;
+    intensity = 255.0f * hit.reflectivity * (0.35f + 0.65f * cos_incidence) +
+                (noise_.noiseless ? 0.0f : 6.0f * (uniform16(bits, 3) - 0.5f));
+  }
+  intensity = std::clamp(intensity, 0.0f, 255.0f);
+  return range >= min_range && range <= max_range;
+}
+
 LidarScan LidarSimulator::simulate(LocalRayCaster& caster, const PoseAt& pose_at, double t_end, std::int64_t utime,
                                    std::int64_t seq, std::uint64_t seed) const {
   const int C = profile_.columns, J = profile_.channels();
@@ -111,84 +188,33 @@ LidarScan LidarSimulator::simulate(LocalRayCaster& caster, const PoseAt& pose_at
   scan.points.reserve(static_cast<std::size_t>(C) * J);
 
   Rng rng = Rng::forStream(seed, Stream::LidarSweep, static_cast<std::uint64_t>(seq));
-  const float sigma = static_cast<float>(profile_.range_sigma);
-  const float min_range = static_cast<float>(profile_.min_range), max_range = static_cast<float>(profile_.max_range);
-  const float sin_grazing = static_cast<float>(std::sin(10.0 * kDeg));
   const double period = profile_.columnPeriod(), span = kPoseStride * period;
-  std::vector<float> channel_dt(J);
+  const float max_range = static_cast<float>(profile_.max_range);
+  std::vector<float> channel_dt(J), noise(J + 1);
   for (int j = 0; j < J; ++j) channel_dt[j] = static_cast<float>(firingOffset(C - 1, j));
-  std::vector<float> noise(J + 1);
 
   caster.moveTo(pose_at(t_end).translation().cast<float>());
   const double t_first = t_end + firingOffset(0, 0);
   Eigen::Isometry3d pose_b = pose_at(t_first);
-  Eigen::Matrix3f Ra = Eigen::Matrix3f::Identity();
-  Eigen::Vector3f pa = Eigen::Vector3f::Zero(), dp = Eigen::Vector3f::Zero(), phi = Eigen::Vector3f::Zero();
+  PoseBlock block;
   for (int c = 0; c < C; ++c) {
     if (c % kPoseStride == 0) {
-      // Exact poses at the ends of the next kPoseStride columns; first-order interpolation in between.
       const Eigen::Isometry3d pose_a = pose_b;
       pose_b = pose_at(t_first + (c + kPoseStride) * period);
-      Ra = pose_a.linear().cast<float>();
-      pa = pose_a.translation().cast<float>();
-      dp = (pose_b.translation() - pose_a.translation()).cast<float>();
-      const Eigen::Matrix3d dR = pose_a.linear().transpose() * pose_b.linear();
-      phi = 0.5 * Eigen::Vector3d(dR(2, 1) - dR(1, 2), dR(0, 2) - dR(2, 0), dR(1, 0) - dR(0, 1)).cast<float>();
+      block = PoseBlock(pose_a, pose_b);
     }
-    // Range noise for the whole sequence: Marsaglia's polar method gives normal pairs without sin/cos. Its
-    // rejection loop depends only on the random numbers, never on the geometry, so a sweep's noise stays the
-    // same firing for firing whatever the poses.
-    for (int j = 0; j < J; j += 2) {
-      double x, y, r2;
-      do {
-        x = 2.0 * rng.uniform() - 1.0;
-        y = 2.0 * rng.uniform() - 1.0;
-        r2 = x * x + y * y;
-      } while (r2 >= 1.0 || r2 == 0.0);
-      const double f = std::sqrt(-2.0 * std::log(r2) / r2);
-      noise[j] = static_cast<float>(x * f);
-      noise[j + 1] = static_cast<float>(y * f);
-    }
+    normalPairs(rng, noise.data(), J);  // a fixed number of normal pairs per sequence
     const float column_dt = static_cast<float>((c - (C - 1)) * period);
-    const float column_sigma = static_cast<float>((c % kPoseStride) * period / span);
+    const float column_s = static_cast<float>((c % kPoseStride) * period / span);
     for (int j = 0; j < J; ++j) {
       const Eigen::Vector3f& d = directions_[static_cast<std::size_t>(c) * J + j];
-      const float s = column_sigma + static_cast<float>(j * profile_.firing_slot / span);
-      Ray ray;
-      ray.origin = pa + s * dp;
-      ray.dir = Ra * (d + s * phi.cross(d));  // unit to ~1e-9: the rotation step is tiny
-      ray.t_max = max_range;
-      // One 64-bit draw gives four 16-bit uniforms: dropout, dust, dust range, intensity jitter.
-      const std::uint64_t bits = rng.next();
-      auto u16 = [bits](int k) { return (static_cast<float>((bits >> (16 * k)) & 0xFFFF) + 0.5f) * (1.0f / 65536.0f); };
-
-      const Hit hit = caster.intersect(ray);
-      float range = 0.0f, intensity = 0.0f;
-      if (!noise_.noiseless && noise_.dust && u16(1) < noise_.dust_probability) {
-        const float r_dust = min_range - static_cast<float>(noise_.dust_mean_range) * std::log(1.0f - u16(2));
-        if (!hit.valid() || r_dust < hit.t) {
-          range = r_dust;
-          intensity = 2.0f + 6.0f * u16(3);
-        }
-      }
-      if (range == 0.0f) {
-        if (!hit.valid()) continue;
-        const float cos_incidence = std::fabs(hit.normal.dot(ray.dir));
-        if (!noise_.noiseless) {
-          const float grazing = std::max(0.0f, 1.0f - cos_incidence / sin_grazing);
-          const float far = hit.t / max_range;
-          const float p_drop = static_cast<float>(noise_.dropout + noise_.grazing_dropout * grazing +
-                                                  noise_.dark_dropout * (1.0f - hit.reflectivity) * far * far);
-          if (u16(0) < p_drop) continue;
-        }
-        range = noise_.noiseless ? hit.t : hit.t + sigma * noise[j];
-        intensity = 255.0f * hit.reflectivity * (0.35f + 0.65f * cos_incidence) +
-                    (noise_.noiseless ? 0.0f : 6.0f * (u16(3) - 0.5f));
-      }
-      if (range < min_range || range > max_range) continue;
+      const Ray ray = block.ray(d, column_s + static_cast<float>(j * profile_.firing_slot / span), max_range);
+      const std::uint64_t bits = rng.next();  // four 16-bit uniforms for the measurement model
+      float range, intensity;
+      if (!measure(caster.intersect(ray), ray, noise[j], bits, range, intensity)) continue;
       LidarPoint pt;
       pt.p = range * d;
-      pt.intensity = std::clamp(intensity, 0.0f, 255.0f);
+      pt.intensity = intensity;
       pt.ring = rings_[j];
       pt.dt = column_dt + channel_dt[j];
       scan.points.push_back(pt);

@@ -92,6 +92,9 @@ class LidarSimulator {
   double firingOffset(int column, int channel) const;
 
  private:
+  // Measurement model for one firing: dust, dropouts, range noise, intensity. False = no return.
+  bool measure(const Hit& hit, const Ray& ray, float noise, std::uint64_t bits, float& range, float& intensity) const;
+
   LidarProfile profile_;
   LidarNoiseConfig noise_;
   std::vector<std::uint16_t> rings_;

@@ -71,6 +71,113 @@ double PlannedMotion::timeAtDistance(double metres) const {
   return knot_times[static_cast<std::size_t>(it - knot_distance.begin())];
 }
 
+namespace {
+
+// Distance and speed along the path over time, from the speed profile (constant acceleration per grid cell).
+class SpeedPlan {
+ public:
+  SpeedPlan(const Path2d& path, std::vector<double> v, double start_time)
+      : length_(path.length()), v_(std::move(v)), start_(start_time) {
+    n_ = static_cast<int>(v_.size()) - 1;
+    ds_ = length_ / std::max(1, n_);
+    t_grid_.assign(n_ + 1, 0.0);  // time to reach grid point i from the start of motion
+    for (int i = 0; i < n_; ++i) t_grid_[i + 1] = t_grid_[i] + 2 * ds_ / std::max(1e-6, v_[i] + v_[i + 1]);
+  }
+
+  double distanceAt(double t, double& speed) const {
+    t -= start_;
+    if (t <= 0.0 || n_ <= 0) {
+      speed = 0.0;
+      return 0.0;
+    }
+    if (t >= t_grid_[n_]) {
+      speed = v_[n_];
+      return length_ + v_[n_] * (t - t_grid_[n_]);
+    }
+    const int i = static_cast<int>(std::upper_bound(t_grid_.begin(), t_grid_.end(), t) - t_grid_.begin()) - 1;
+    const double a = (v_[i + 1] * v_[i + 1] - v_[i] * v_[i]) / (2 * ds_), tau = t - t_grid_[i];
+    speed = v_[i] + a * tau;
+    return std::min(i * ds_ + v_[i] * tau + 0.5 * a * tau * tau, (i + 1) * ds_);
+  }
+
+ private:
+  double length_;
+  std::vector<double> v_, t_grid_;
+  double start_, ds_ = 0.0;
+  int n_ = 0;
+};
+
+// Chassis vibration: per axis (pitch, roll, yaw, height) a sum of 3 sinusoids, unit RMS, amplitude ~ 1/f.
+class Vibration {
+ public:
+  Vibration(Rng& rng, double f_min, double f_max) {
+    const double lo = std::max(0.05, f_min), hi = std::max(lo, f_max);
+    for (auto& axis : tones_) {
+      double power = 0.0;
+      for (Tone& tone : axis) {
+        const double f = lo * std::pow(hi / lo, rng.uniform());
+        tone = {2 * M_PI * f, rng.uniform(0.0, 2 * M_PI), 1.0 / f};
+        power += 0.5 * tone.amplitude * tone.amplitude;
+      }
+      for (Tone& tone : axis) tone.amplitude /= std::sqrt(power);
+    }
+  }
+  double value(int axis, double t) const {
+    double sum = 0.0;
+    for (const Tone& tone : tones_[axis]) sum += tone.amplitude * std::sin(tone.omega * t + tone.phase);
+    return sum;
+  }
+
+ private:
+  struct Tone {
+    double omega, phase, amplitude;
+  };
+  std::array<std::array<Tone, 3>, 4> tones_{};
+};
+
+// Two passes of a centred moving average of half-width `half` samples (the window shrinks at the ends).
+void smooth(std::vector<double>& series, int half) {
+  const int n = static_cast<int>(series.size());
+  for (int pass = 0; pass < 2 && half > 0; ++pass) {
+    std::vector<double> prefix(n + 1, 0.0);
+    for (int k = 0; k < n; ++k) prefix[k + 1] = prefix[k] + series[k];
+    for (int k = 0; k < n; ++k) {
+      const int w = std::min({half, k, n - 1 - k});
+      series[k] = (prefix[k + w + 1] - prefix[k - w]) / (2 * w + 1);
+    }
+  }
+}
+
+struct GroundContact {
+  double z, pitch, roll;  // ground height under the robot, and its attitude on the floor
+};
+
+// Least-squares plane through 5 floor samples along each track: bumps shorter than the tracks are bridged, as a
+// real crawler does. Nose up = negative pitch, left side up = positive roll (z-y-x Euler angles).
+GroundContact trackPlane(const World& world, const Eigen::Vector2d& xy, double yaw, const MotionConfig& c) {
+  const Eigen::Vector2d fwd(std::cos(yaw), std::sin(yaw)), left(-std::sin(yaw), std::cos(yaw));
+  double h[2][5], mean = 0.0, side_diff = 0.0;
+  for (int side = 0; side < 2; ++side) {
+    for (int i = 0; i < 5; ++i) {
+      const Eigen::Vector2d q = xy + c.track_length * (i - 2) / 4.0 * fwd + (side == 0 ? 0.5 : -0.5) * c.track_width * left;
+      h[side][i] = world.groundHeight(q.x(), q.y());
+      mean += h[side][i] / 10.0;
+      side_diff += (side == 0 ? 1.0 : -1.0) * h[side][i] / 5.0;
+    }
+  }
+  double num = 0.0, den = 0.0;
+  for (int side = 0; side < 2; ++side) {
+    for (int i = 0; i < 5; ++i) {
+      const double f = c.track_length * (i - 2) / 4.0;
+      num += f * (h[side][i] - mean);
+      den += f * f;
+    }
+  }
+  return {mean, -std::atan(num / den), std::atan2(side_diff, c.track_width)};
+}
+
+}  // namespace
+
 PlannedMotion planMotion(const World& world, const MotionConfig& c, double duration, std::uint64_t seed) {
   Rng rng = Rng::forStream(seed, Stream::Motion);
   const double horizon = std::max(0.0, duration) + 1.0;
@@ -83,144 +190,60 @@ PlannedMotion planMotion(const World& world, const MotionConfig& c, double durat
     for (int k = 1; k < laps; ++k) waypoints.insert(waypoints.end(), world.route.begin() + 1, world.route.end());
   }
   const Path2d path(waypoints, c.corner_radius);
-  const std::vector<double> v = speedProfile(path, c, !world.route_closed, rng);
-  const int n = static_cast<int>(v.size()) - 1;
-  const double ds = path.length() / std::max(1, n);
-  std::vector<double> t_grid(n + 1, 0.0);  // time to reach grid point i, from the end of the still period
-  for (int i = 0; i < n; ++i) t_grid[i + 1] = t_grid[i] + 2 * ds / std::max(1e-6, v[i] + v[i + 1]);
-
-  // Distance and speed at time t: constant acceleration within a grid cell (v^2 linear in s).
-  // The smoothing below reaches smoothing_window back in time: start the plan that much later so the robot is
+  // The smoothing below reaches smoothing_window back in time: start moving that much later so the robot is
   // exactly still for start_still seconds.
-  const double motion_start = c.start_still + std::max(0.0, c.smoothing_window);
-  auto distanceAt = [&](double t, double& speed) {
-    t -= motion_start;
-    if (t <= 0.0 || n == 0) {
-      speed = 0.0;
-      return 0.0;
-    }
-    if (t >= t_grid[n]) {
-      speed = v[n];
-      return path.length() + v[n] * (t - t_grid[n]);
-    }
-    const int i = static_cast<int>(std::upper_bound(t_grid.begin(), t_grid.end(), t) - t_grid.begin()) - 1;
-    const double a = (v[i + 1] * v[i + 1] - v[i] * v[i]) / (2 * ds), tau = t - t_grid[i];
-    speed = v[i] + a * tau;
-    return std::min(i * ds + v[i] * tau + 0.5 * a * tau * tau, (i + 1) * ds);
-  };
-
+  const SpeedPlan plan(path, speedProfile(path, c, !world.route_closed, rng),
+                       c.start_still + std::max(0.0, c.smoothing_window));
   const double w1 = rng.uniform(20.0, 35.0), w2 = rng.uniform(45.0, 80.0);
   const double q1 = rng.uniform(0.0, 2 * M_PI), q2 = rng.uniform(0.0, 2 * M_PI);
   auto wander = [&](double s) {
     return c.wander * (0.6 * std::sin(2 * M_PI * s / w1 + q1) + 0.4 * std::sin(2 * M_PI * s / w2 + q2));
   };
+  const Vibration vibration(rng, c.vibration_min_hz, c.vibration_max_hz);
 
   PlannedMotion out;
   out.route_length = path.length();
   out.lap_length = Path2d(world.route, c.corner_radius).length();
   const double dt = c.knot_spacing;
-  const double t0 = 0.0;
   const int controls = static_cast<int>(std::ceil(horizon / dt)) + 4;
-  // Vibration: per axis (pitch, roll, yaw, height) 3 sinusoids, unit RMS in total.
-  struct Tone {
-    double omega, phase, amplitude;
-  };
-  std::array<std::array<Tone, 3>, 4> tones;
-  const double f_lo = std::max(0.05, c.vibration_min_hz), f_hi = std::max(f_lo, c.vibration_max_hz);
-  for (auto& axis : tones) {
-    double power = 0.0;
-    for (Tone& tone : axis) {
-      const double f = f_lo * std::pow(f_hi / f_lo, rng.uniform());
-      tone = {2 * M_PI * f, rng.uniform(0.0, 2 * M_PI), 1.0 / f};
-      power += 0.5 * tone.amplitude * tone.amplitude;
-    }
-    for (Tone& tone : axis) tone.amplitude /= std::sqrt(power);
-  }
-  auto vibration = [&](int axis, double t) {
-    double sum = 0.0;
-    for (const Tone& tone : tones[axis]) sum += tone.amplitude * std::sin(tone.omega * t + tone.phase);
-    return sum;
-  };
-  std::vector<Eigen::Isometry3d> poses;
-  poses.reserve(controls);
+  auto knotTime = [dt](int k) { return (k - 1) * dt; };  // control k belongs to time (k - 1) dt
+
   // Pass 1: planar pose along the path (with wander) at every knot; heading unwrapped.
-  std::vector<double> xs(controls), ys(controls), yaws(controls), speeds(controls), dists(controls);
+  std::vector<double> xs(controls), ys(controls), yaws(controls), speeds(controls);
+  out.knot_times.resize(controls);
+  out.knot_distance.resize(controls);
   for (int k = 0; k < controls; ++k) {
-    const double t = t0 + (k - 1) * dt;
-    dists[k] = distanceAt(t, speeds[k]);
-    const double s_path = std::min(dists[k], path.length());
-    const Path2d::Sample ps = path.at(s_path);
-    const double offset = wander(s_path), slope = (wander(s_path + 0.05) - wander(s_path - 0.05)) / 0.1;
-    const Eigen::Vector2d xy = ps.position + offset * Eigen::Vector2d(-std::sin(ps.heading), std::cos(ps.heading));
-    xs[k] = xy.x();
-    ys[k] = xy.y();
+    out.knot_times[k] = knotTime(k);
+    out.knot_distance[k] = plan.distanceAt(knotTime(k), speeds[k]);
+    const double s = std::min(out.knot_distance[k], path.length());
+    const Path2d::Sample ps = path.at(s);
+    const double offset = wander(s), slope = (wander(s + 0.05) - wander(s - 0.05)) / 0.1;
+    xs[k] = ps.position.x() - offset * std::sin(ps.heading);
+    ys[k] = ps.position.y() + offset * std::cos(ps.heading);
     yaws[k] = ps.heading + std::atan(slope);
     if (k > 0) yaws[k] = yaws[k - 1] + std::remainder(yaws[k] - yaws[k - 1], 2 * M_PI);
   }
-  // Pass 2: a real vehicle cannot jump in curvature or acceleration (arcs start abruptly on the geometric path):
-  // smooth the planar motion with two passes of a centred moving average over smoothing_window seconds.
+  // Pass 2: a vehicle cannot jump in curvature or acceleration (the geometric path's arcs start abruptly).
   const int half_window = std::max(0, static_cast<int>(std::lround(0.5 * c.smoothing_window / dt)));
-  for (std::vector<double>* series : {&xs, &ys, &yaws}) {
-    for (int pass = 0; pass < 2 && half_window > 0; ++pass) {
-      std::vector<double> prefix(controls + 1, 0.0);
-      for (int k = 0; k < controls; ++k) prefix[k + 1] = prefix[k] + (*series)[k];
-      std::vector<double> out(controls);
-      for (int k = 0; k < controls; ++k) {
-        const int lo = std::max(0, k - half_window), hi = std::min(controls - 1, k + half_window);
-        const int w = std::min(k - lo, hi - k);  // symmetric window, shrinking at the ends
-        out[k] = (prefix[k + w + 1] - prefix[k - w]) / (2 * w + 1);
-      }
-      *series = out;
-    }
-  }
-  // Pass 3: height and attitude from the floor, vibration, lidar on its mast.
+  for (std::vector<double>* series : {&xs, &ys, &yaws}) smooth(*series, half_window);
+
+  // Pass 3: height and attitude from the floor, vibration scaled by speed, lidar on its mast.
+  std::vector<Eigen::Isometry3d> poses(controls, Eigen::Isometry3d::Identity());
   for (int k = 0; k < controls; ++k) {
-    const double t = t0 + (k - 1) * dt;
-    const double speed = speeds[k], s = dists[k];
-    const Eigen::Vector2d xy(xs[k], ys[k]);
-    const double yaw = yaws[k];
-
-    // Attitude from the ground under the tracks: a least-squares plane through 5 samples along each track, so
-    // bumps shorter than the tracks are bridged as a real crawler does.
-    const Eigen::Vector2d fwd(std::cos(yaw), std::sin(yaw)), left(-std::sin(yaw), std::cos(yaw));
-    double mean = 0.0, side_diff = 0.0, slope_num = 0.0, slope_den = 0.0;
-    double heights[2][5];
-    for (int side = 0; side < 2; ++side) {
-      for (int i = 0; i < 5; ++i) {
-        const double f = c.track_length * (i - 2) / 4.0, l = (side == 0 ? 0.5 : -0.5) * c.track_width;
-        const Eigen::Vector2d q = xy + f * fwd + l * left;
-        heights[side][i] = world.groundHeight(q.x(), q.y());
-        mean += heights[side][i] / 10.0;
-        side_diff += (side == 0 ? 1.0 : -1.0) * heights[side][i] / 5.0;
-      }
-    }
-    for (int side = 0; side < 2; ++side) {
-      for (int i = 0; i < 5; ++i) {
-        const double f = c.track_length * (i - 2) / 4.0;
-        slope_num += f * (heights[side][i] - mean);
-        slope_den += f * f;
-      }
-    }
-    const double z_ground = mean;
-    const double pitch_floor = -std::atan(slope_num / slope_den);      // nose up = negative pitch
-    const double roll_floor = std::atan2(side_diff, c.track_width);  // left side up = positive roll
-
-    const Eigen::Vector4d vib(vibration(0, t), vibration(1, t), vibration(2, t), vibration(3, t));
-    const double scale = std::min(1.5, speed / 1.0);
+    const double t = knotTime(k);
+    const GroundContact ground = trackPlane(world, {xs[k], ys[k]}, yaws[k], c);
+    const double scale = std::min(1.5, speeds[k] / 1.0);
     const double sigma = c.vibration_deg * kDegToRad * scale;
-    const Eigen::Matrix3d R = (Eigen::AngleAxisd(yaw + sigma / 3 * vib[2], Eigen::Vector3d::UnitZ()) *
-                               Eigen::AngleAxisd(pitch_floor + sigma * vib[0], Eigen::Vector3d::UnitY()) *
-                               Eigen::AngleAxisd(roll_floor + sigma * vib[1], Eigen::Vector3d::UnitX()))
-                                  .toRotationMatrix();
-    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-    T.linear() = R;
-    T.translation() = Eigen::Vector3d(xy.x(), xy.y(), z_ground + c.bounce * scale * vib[3]) +
-                      R * Eigen::Vector3d(0.0, 0.0, c.mount_height);
-    poses.push_back(T);
-    out.knot_times.push_back(t);
-    out.knot_distance.push_back(s);
+    const Eigen::Matrix3d R =
+        (Eigen::AngleAxisd(yaws[k] + sigma / 3 * vibration.value(2, t), Eigen::Vector3d::UnitZ()) *
+         Eigen::AngleAxisd(ground.pitch + sigma * vibration.value(0, t), Eigen::Vector3d::UnitY()) *
+         Eigen::AngleAxisd(ground.roll + sigma * vibration.value(1, t), Eigen::Vector3d::UnitX()))
+            .toRotationMatrix();
+    poses[k].linear() = R;
+    poses[k].translation() = Eigen::Vector3d(xs[k], ys[k], ground.z + c.bounce * scale * vibration.value(3, t)) +
+                             R * Eigen::Vector3d(0.0, 0.0, c.mount_height);
   }
-  out.trajectory = BSplineTrajectory(t0, dt, std::move(poses));
+  out.trajectory = BSplineTrajectory(0.0, dt, std::move(poses));
   return out;
 }
 
