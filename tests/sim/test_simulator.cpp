@@ -5,6 +5,9 @@
 #include <gtest/gtest.h>
 
 #include <cstring>
+#include <string>
+#include <utility>
+#include <vector>
 
 namespace adit::sim {
 namespace {
@@ -184,6 +187,51 @@ TEST(SimulatorConfig, KeysAndErrors) {
   ASSERT_TRUE(zero.next(ev));  // the IMU sample at time 0
   EXPECT_EQ(ev.kind, SimEvent::Kind::Imu);
   EXPECT_FALSE(zero.next(ev));
+}
+
+// launch/worlds/roadway-loop.yaml lists every key with its default: keep it and the code in agreement.
+TEST(SimulatorConfig, ReferenceWorldFileMatchesTheDefaults) {
+  const SimConfig c = simConfigFrom(adit::Config::fromYamlFile(ADIT_SOURCE_DIR "/launch/worlds/roadway-loop.yaml"));
+  const SimConfig d;
+  const WorldConfig w = worldConfigFor("roadway-loop", 1);
+  EXPECT_EQ(c.world, d.world);
+  EXPECT_EQ(c.sensor, d.sensor);
+  EXPECT_DOUBLE_EQ(c.duration_s, 500.0);
+  EXPECT_EQ(c.seed, d.seed);
+  EXPECT_EQ(c.lidar.dust, d.lidar.dust);
+  const WorldConfig& r = *c.roadway;
+  for (const auto& [a, b] : std::vector<std::pair<double, double>>{
+           {r.width, w.width}, {r.wall_height, w.wall_height}, {r.roof_rise, w.roof_rise},
+           {r.floor_roughness, w.floor_roughness}, {r.wall_roughness, w.wall_roughness},
+           {r.grade_amplitude, w.grade_amplitude}, {r.arch_spacing, w.arch_spacing}, {r.bolt_spacing, w.bolt_spacing},
+           {r.loop_size_x, w.loop_size_x}, {r.loop_size_y, w.loop_size_y},
+           {double(r.loop_crosscuts), double(w.loop_crosscuts)},
+           {c.motion.cruise_speed, d.motion.cruise_speed}, {c.motion.speed_variation, d.motion.speed_variation},
+           {c.motion.max_speed, d.motion.max_speed}, {c.motion.max_accel, d.motion.max_accel},
+           {c.motion.max_decel, d.motion.max_decel}, {c.motion.lateral_accel, d.motion.lateral_accel},
+           {c.motion.corner_radius, d.motion.corner_radius}, {c.motion.wander, d.motion.wander},
+           {c.motion.start_still, d.motion.start_still}, {c.motion.mount_height, d.motion.mount_height},
+           {c.motion.track_length, d.motion.track_length}, {c.motion.track_width, d.motion.track_width},
+           {c.motion.vibration_deg, d.motion.vibration_deg}, {c.motion.bounce, d.motion.bounce},
+           {c.motion.vibration_min_hz, d.motion.vibration_min_hz}, {c.motion.vibration_max_hz, d.motion.vibration_max_hz},
+           {c.motion.knot_spacing, d.motion.knot_spacing}, {c.motion.smoothing_window, d.motion.smoothing_window},
+           {c.lidar.range_sigma, lidarProfile("vlp16").range_sigma}, {c.lidar.dropout, d.lidar.dropout},
+           {c.lidar.grazing_dropout, d.lidar.grazing_dropout}, {c.lidar.dark_dropout, d.lidar.dark_dropout},
+           {c.lidar.dust_probability, d.lidar.dust_probability}, {c.lidar.dust_mean_range, d.lidar.dust_mean_range},
+           {c.lidar.cut_azimuth_deg, d.lidar.cut_azimuth_deg}, {c.imu.rate_hz, d.imu.rate_hz},
+           {c.imu.gyro_noise, d.imu.gyro_noise}, {c.imu.gyro_bias_walk, d.imu.gyro_bias_walk},
+           {c.imu.gyro_bias_init, d.imu.gyro_bias_init}, {c.imu.accel_noise, d.imu.accel_noise},
+           {c.imu.accel_bias_walk, d.imu.accel_bias_walk}, {c.imu.accel_bias_init, d.imu.accel_bias_init},
+           {c.imu.gravity, d.imu.gravity}})
+    EXPECT_DOUBLE_EQ(a, b);
+  EXPECT_EQ(r.support_arches && r.roof_bolts && r.services && r.equipment && r.side_cuts, true);
+  EXPECT_FALSE(c.lidar.noiseless || c.imu.noiseless);
+  // The other example worlds parse and build.
+  for (const char* file : {"dusty-straight-rs16.yaml", "aliasing-room-and-pillar.yaml"}) {
+    SimConfig e = simConfigFrom(adit::Config::fromYamlFile(std::string(ADIT_SOURCE_DIR "/launch/worlds/") + file));
+    e.duration_s = 1.0;
+    EXPECT_NO_THROW(Simulator{e}) << file;
+  }
 }
 
 TEST(SimulatorWorldCloud, PointsLieOnSurfacesWithRequestedDensity) {
