@@ -12,7 +12,7 @@
 namespace adit::sim {
 namespace {
 
-constexpr int kMaxLeafSize = 4;
+constexpr int kMaxLeafSize = 2;  // measured: 2 beats 1, 3 and 4 for lidar rays in roadways
 constexpr int kBins = 16;
 
 float area(const Eigen::AlignedBox3f& b) {
