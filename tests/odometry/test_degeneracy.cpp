@@ -109,7 +109,7 @@ TEST(Degeneracy, PriorHoldsTheAxisAgainstAWrongSeed) {
 }
 
 TEST(Degeneracy, AxisDriftIsBoundedComparedWithNoPrior) {
-  const auto run = [](bool prior) {
+  const auto run = [](bool prior) -> Eigen::Vector3d {
     const auto est = drive(test::featurelessCorridor(), 16, prior);
     // Per-sweep motions are relative; their product is the odometry from sweep 1 to the end.
     Eigen::Isometry3d odom = Eigen::Isometry3d::Identity();
