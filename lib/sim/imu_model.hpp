@@ -4,7 +4,8 @@
 //   gyro  = omega_body(t) + b_g + n_g,        n_g ~ N(0, gyro_noise^2 * rate)      (per sample)
 //   accel = R(t)^T (a_world(t) - g) + b_a + n_a, g = (0, 0, -gravity)             (+gravity up at rest)
 //   b_g, b_a: start ~N(0, *_bias_init^2) per axis, random walk b += N(0, *_bias_walk^2 / rate) per sample.
-// The IMU frame is the lidar frame (identity extrinsic, documented in simulator.hpp).
+// The IMU frame is the lidar frame (identity extrinsic, documented in simulator.hpp). The optional orientation
+// and magnetic_field of ImuSample are left empty: the N100's on-board AHRS output is not modelled.
 #pragma once
 
 #include "core/config.hpp"

@@ -13,7 +13,7 @@
 // simulateSweep(k) alone gives the same scan as the k-th sweep of the stream.
 //
 // Demo duration: roadway-loop's circuit is 510 m (507 m as driven, corners rounded); at the default cruise speed
-// 1.3 m/s the robot completes one lap about 400 s after time 0 and 1.2 laps (608 m) at about 480 s (it stands
+// 1.3 m/s the robot completes one lap about 405 s after time 0 and 1.2 laps (608 m) at about 483 s (it stands
 // still for the first 2 s). Use --duration 500 for the demo: a loop closure with a real revisit. The exact
 // figures for a config are timeAtDistance(lapLength()) and timeAtDistance(1.2 * lapLength()); test_sim prints
 // and checks them.

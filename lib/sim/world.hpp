@@ -8,7 +8,8 @@
 //                     closure). See simulator.hpp for the duration needed to drive 1.2 laps.
 //   room-and-pillar   a 6 x 6 grid of junctions between 15 m square pillars: many identical intersections
 //                     (perceptual aliasing); the robot does a seeded random walk through it.
-//   featureless       a 320 m smooth arched tunnel, no furniture: scan matching is degenerate along the axis.
+//   featureless       a 320 m smooth arched tunnel, no furniture: scan matching is degenerate along the axis
+//                     wherever both end walls are beyond the lidar's 100 m (x in ~100..220 m).
 //
 // Frame: world z up, x east; the floor's mean height is z = 0 plus the slow grade. Everything derives from the
 // seed; the same WorldConfig gives the same world bit for bit.

@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <map>
 
 namespace adit::sim {
@@ -76,6 +77,7 @@ TEST(LidarGeometry, NoiselessCloudMatchesAnalyticRoadway) {
     return best;
   };
   int floor = 0, walls = 0, roof = 0;
+  double worst = 0.0;
   for (const LidarPoint& p : scan.points) {
     const Eigen::Vector3d w = p.p.cast<double>() + Eigen::Vector3d(100.0, 0.3, h);
     // Elevation of each point is its ring's beam angle.
@@ -86,11 +88,14 @@ TEST(LidarGeometry, NoiselessCloudMatchesAnalyticRoadway) {
     const double d_wall = std::fabs(std::fabs(w.y()) - half) + (w.z() > hw + 1e-3 || w.z() < -1e-3 ? 1.0 : 0.0);
     const double d_roof = archDistance({w.y(), w.z()});
     const double d = std::min({d_floor, d_wall, d_roof});
+    worst = std::max(worst, d);
     EXPECT_LT(d, 1e-3) << w.transpose();
     floor += d == d_floor;
     walls += d == d_wall && d != d_floor;
     roof += d == d_roof && d != d_floor && d != d_wall;
   }
+  std::printf("geometry: %zu points, floor %d walls %d roof %d, worst distance to the analytic section %.2e m\n",
+              scan.points.size(), floor, walls, roof, worst);
   EXPECT_GT(floor, 1500);
   EXPECT_GT(walls, 15000);
   EXPECT_GT(roof, 1500);
@@ -118,6 +123,8 @@ TEST(LidarGeometry, RangeNoiseAndDropoutsAsConfigured) {
     ++n;
   }
   const double mean = sum / n, sigma = std::sqrt(sum2 / n - mean * mean);
+  std::printf("range noise: mean %.2e m, sigma %.4f m over %d points, lost %.1f %%\n", mean, sigma, n,
+              100.0 * (1.0 - static_cast<double>(a.points.size()) / b.points.size()));
   EXPECT_NEAR(mean, 0.0, 0.001);
   EXPECT_NEAR(sigma, 0.02, 0.002);  // profile range_sigma
   const double lost = 1.0 - static_cast<double>(a.points.size()) / b.points.size();
@@ -185,6 +192,8 @@ TEST(LidarDistortion, TranslationShiftsEachFiringByVelocityTimesDt) {
     max_error = std::max(max_error, std::fabs(shift - expected));
     ++compared;
   }
+  std::printf("distortion: %d firings on the end walls, max shift %.4f m, max |shift - v|dt|| %.2e m\n", compared,
+              max_shift, max_error);
   EXPECT_GT(compared, 1000);
   EXPECT_GT(max_shift, 0.14);   // up to v * 0.1 s = 15 cm at the seam behind: deskewing is needed
   EXPECT_LT(max_error, 2e-4);   // float precision at 20 m: the distortion is exactly the motion
@@ -223,7 +232,8 @@ TEST(LidarDistortion, RealRunFiringsUseThePoseAtTheirOwnTime) {
     max_exact = std::max(max_exact, std::fabs(double(hit.t) - p.p.norm()));
     max_naive = std::max(max_naive, ((T_end * p.p.cast<double>()) - (T * p.p.cast<double>())).norm());
   }
-  EXPECT_LT(max_exact, 2e-3);  // interpolation inside 0.44 ms + float rounding
+  std::printf("real run: max |recast - measured| %.2e m, max naive (no deskew) error %.3f m\n", max_exact, max_naive);
+  EXPECT_LT(max_exact, 5e-4);  // interpolation inside 0.44 ms + float rounding (observed ~6e-5 m)
   EXPECT_GT(max_naive, 0.1);
 }
 
