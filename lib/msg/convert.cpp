@@ -180,6 +180,9 @@ adit::odometry_t toMessage(const PoseEstimate& pose, const FeatureSet* features)
     m.rotation_eigenvalues[i] = pose.rotation_eigenvalues[i];
   }
   m.flags = pose.flags;
+  const double identity_position[3] = {0, 0, 0}, identity_rotation[4] = {1, 0, 0, 0};
+  std::copy(identity_position, identity_position + 3, m.loop_correction_position);
+  std::copy(identity_rotation, identity_rotation + 4, m.loop_correction_orientation);
   m.iterations = pose.iterations;
   m.final_cost = pose.final_cost;
   m.features = features ? toMessage(*features) : toMessage(FeatureSet{});

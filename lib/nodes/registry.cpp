@@ -2,6 +2,8 @@
 
 #include "nodes/feature_node.hpp"
 #include "nodes/loop_closer_node.hpp"
+#include "nodes/mapper_node.hpp"
+#include "nodes/odometry_node.hpp"
 #include "runtime/process.hpp"
 
 namespace adit::nodes {
@@ -13,10 +15,8 @@ const std::vector<std::string>& pipelineNodeNames() {
 
 std::unique_ptr<runtime::Node> makeNode(const std::string& name, const Config& config) {
   if (name == "feature") return makeFeatureNode(config);
-  if (name == "odometry")
-    throw runtime::StageNotImplemented("the scan-to-scan odometry stage is not written yet: issue 5");
-  if (name == "mapper")
-    throw runtime::StageNotImplemented("the scan-to-map mapping stage is not written yet: issue 5");
+  if (name == "odometry") return makeOdometryNode(config);
+  if (name == "mapper") return makeMapperNode(config);
   if (name == "loop_closer") return makeLoopCloserNode(config);
   throw std::runtime_error("no pipeline node named '" + name + "'");
 }

@@ -16,6 +16,7 @@ struct Health {
   std::map<std::string, std::int64_t> counters;  // named, e.g. "decode_error", "time_backwards"
   std::string last_error;
   std::int64_t last_input_utime = 0;
+  double busy_s = 0;  // total processing time (monitoring only)
 };
 
 // Processing times over a sliding window, for p50 / p95 / max on STATUS.

@@ -42,7 +42,9 @@ void Node::deliver(const std::string& channel, const std::uint8_t* data, std::si
       // A stage that throws on one input must not take the process down: count it and go on.
       reportError("stage_exception", std::string("stage failed on ") + channel + ": " + e.what());
     }
-    timing_.add(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+    const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    timing_.add(ms);
+    health_.busy_s += ms * 1e-3;
     sink_ = nullptr;
   }
 }
@@ -57,8 +59,16 @@ void Node::finish(Sink& sink) {
   sink_ = nullptr;
 }
 
-bool Node::admit(Input& input, std::int64_t utime) {
+bool Node::admit(Input& input, std::int64_t utime, std::int64_t seq) {
   const std::string& channel = channels_.at(input.port);
+  // A gap in the publisher's sequence numbers: messages lost on the way (network, full socket buffer).
+  if (input.last_seq >= 0 && seq > input.last_seq + 1) {
+    health_.drops += seq - input.last_seq - 1;
+    count("lost_input", seq - input.last_seq - 1);
+    spdlog::warn("[{}] {}: {} message(s) lost before arriving (seq {} after {})", name_, channel,
+                 seq - input.last_seq - 1, seq, input.last_seq);
+  }
+  if (seq >= 0) input.last_seq = seq;
   if (input.last_utime >= 0 && utime <= input.last_utime) {
     reportDrop(utime == input.last_utime ? "duplicate_time" : "time_backwards",
                channel + ": utime " + std::to_string(utime) + " is not after " + std::to_string(input.last_utime) +

@@ -82,9 +82,10 @@ class Node {
     std::string port;
     std::function<void(const std::uint8_t*, std::size_t)> handle;
     std::int64_t last_utime = -1;
+    std::int64_t last_seq = -1;
   };
-  // Returns false (and counts) if utime goes backwards or repeats on this input.
-  bool admit(Input& input, std::int64_t utime);
+  // Counts sequence gaps; returns false (and counts) if utime goes backwards or repeats on this input.
+  bool admit(Input& input, std::int64_t utime, std::int64_t seq);
   void emit(const std::string& port, Bytes bytes, std::int64_t utime);
 
   std::string name_;
@@ -116,7 +117,7 @@ void Node::subscribe(const std::string& port, const std::string& default_channel
                                       " bytes): skipped");
       return;
     }
-    if (!admit(inputs_.at(port), msg.header.utime)) return;
+    if (!admit(inputs_.at(port), msg.header.utime, msg.header.seq)) return;
     handler(msg);
   };
   inputs_[port] = std::move(input);

@@ -126,15 +126,23 @@ int runNodeProcess(int argc, char** argv, const std::string& name, const std::st
   const auto start = std::chrono::steady_clock::now();
   auto last_status = start;
   std::int64_t status_seq = 0, inputs_at_last_status = 0;
+  double busy_at_last_status = 0;
+  // A stage busy this share of the time cannot keep up: its socket buffer fills and sweeps get lost.
+  constexpr double kBehindBusyFraction = 0.9;
   const auto sendStatus = [&](const std::string& state) {
     const auto now = std::chrono::steady_clock::now();
     const double window = std::chrono::duration<double>(now - last_status).count();
-    const double rate = window > 0 ? static_cast<double>(node->health().inputs - inputs_at_last_status) / window : 0.0;
+    const Health& h = node->health();
+    const double rate = window > 0 ? static_cast<double>(h.inputs - inputs_at_last_status) / window : 0.0;
+    const double busy = window > 0 ? (h.busy_s - busy_at_last_status) / window : 0.0;
+    const std::string reported = state == "running" && busy > kBehindBusyFraction ? "behind" : state;
+    if (reported == "behind") spdlog::warn("busy {:.0f}% of the time: falling behind its input", busy * 100);
     adit::status_t status = makeStatus(*node, wallUtime(), status_seq++,
-                                       std::chrono::duration<double>(now - start).count(), rate, state);
+                                       std::chrono::duration<double>(now - start).count(), rate, busy, reported);
     out.publish(status_channel, &status);
     last_status = now;
-    inputs_at_last_status = node->health().inputs;
+    inputs_at_last_status = h.inputs;
+    busy_at_last_status = h.busy_s;
   };
 
   spdlog::info("listening on {} (status on {})", fmt::join(node->inputChannels(), ", "), status_channel);

@@ -42,7 +42,7 @@ int publishLive(MessageSource& source, const SourceRunOptions& options) {
     h.outputs = published;
     const double rate = window > 0 ? static_cast<double>(published - published_at_last_status) / window : 0.0;
     adit::status_t s = makeStatus(options.process, h, no_timing, wallUtime(), status_seq++,
-                                  std::chrono::duration<double>(now - start).count(), rate, state);
+                                  std::chrono::duration<double>(now - start).count(), rate, 0.0, state);
     lcm.publish(status_channel, &s);
     last_status = now;
     published_at_last_status = published;

@@ -12,7 +12,7 @@ std::string statusChannel(const std::string& process) {
 
 adit::status_t makeStatus(const std::string& process, const Health& health, const TimingWindow& timing,
                           std::int64_t wall_utime, std::int64_t seq, double uptime_s, double rate_hz,
-                          const std::string& state) {
+                          double busy, const std::string& state) {
   adit::status_t s;
   s.header.utime = wall_utime;
   s.header.seq = seq;
@@ -27,6 +27,7 @@ adit::status_t makeStatus(const std::string& process, const Health& health, cons
   s.proc_ms_p50 = static_cast<float>(timing.quantile(0.5));
   s.proc_ms_p95 = static_cast<float>(timing.quantile(0.95));
   s.proc_ms_max = static_cast<float>(timing.max());
+  s.busy_fraction = static_cast<float>(busy);
   s.last_input_utime = health.last_input_utime;
   s.input_rate_hz = static_cast<float>(rate_hz);
   s.num_counters = static_cast<std::int32_t>(health.counters.size());
@@ -39,8 +40,8 @@ adit::status_t makeStatus(const std::string& process, const Health& health, cons
 }
 
 adit::status_t makeStatus(const Node& node, std::int64_t wall_utime, std::int64_t seq, double uptime_s,
-                          double rate_hz, const std::string& state) {
-  return makeStatus(node.name(), node.health(), node.timing(), wall_utime, seq, uptime_s, rate_hz, state);
+                          double rate_hz, double busy, const std::string& state) {
+  return makeStatus(node.name(), node.health(), node.timing(), wall_utime, seq, uptime_s, rate_hz, busy, state);
 }
 
 }  // namespace adit::runtime

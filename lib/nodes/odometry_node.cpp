@@ -1,0 +1,66 @@
+#include "nodes/odometry_node.hpp"
+
+#include "msg/convert.hpp"
+#include "odometry/initial_guess.hpp"
+#include "odometry/scan_to_scan.hpp"
+
+#include <deque>
+#include <optional>
+
+namespace adit::nodes {
+namespace {
+
+class OdometryNode : public runtime::Node {
+ public:
+  explicit OdometryNode(const Config& config)
+      : Node("odometry"), odometry_(scanToScanConfigFrom(config)), guess_config_(initialGuessConfigFrom(config)) {
+    imu_keep_s_ = config.get<double>("odometry.node.imu_keep_s", 1.0);
+    subscribe<adit::features_t>("features", "FEATURES", [this](const adit::features_t& m) { onFeatures(m); });
+    subscribe<adit::imu_t>("imu", "IMU", [this](const adit::imu_t& m) { onImu(m); });
+    advertise("odometry", "ODOM_SCAN");
+  }
+
+ protected:
+  void onTimeJump(const std::string& port) override {
+    if (port == "features") {
+      odometry_.reset();
+      previous_.reset();
+    }
+    if (port == "imu") imu_.clear();
+  }
+
+ private:
+  void onImu(const adit::imu_t& m) {
+    imu_.push_back(msg::fromMessage(m));
+    while (!imu_.empty() && imu_.front().utime < m.header.utime - static_cast<std::int64_t>(imu_keep_s_ * 1e6))
+      imu_.pop_front();
+  }
+
+  void onFeatures(const adit::features_t& m) {
+    FeatureSet features = msg::fromMessage(m);
+    const std::vector<ImuSample> imu(imu_.begin(), imu_.end());
+    const InitialGuess guess = initialGuess(previous_ ? &*previous_ : nullptr, features,
+                                            odometry_.predictMotion(features.utime), imu, guess_config_);
+    count("link3d_matches", guess.link3d_matches);
+    if (guess.flags & PoseEstimate::kSeededByLinK3d) count("seeded_by_link3d");
+    if (guess.flags & PoseEstimate::kSeededByImu) count("seeded_by_imu");
+    const PoseEstimate pose = odometry_.process(features, guess.T_prev_curr, guess.flags);
+    if (pose.flags & PoseEstimate::kRegistrationFailed) count("registration_failed");
+    if (pose.flags & PoseEstimate::kDegenerateTranslation) count("degenerate_translation");
+    adit::odometry_t out = msg::toMessage(pose, &features);
+    publish("odometry", out);
+    previous_ = std::move(features);
+  }
+
+  ScanToScanOdometry odometry_;
+  InitialGuessConfig guess_config_;
+  double imu_keep_s_ = 1.0;
+  std::deque<ImuSample> imu_;
+  std::optional<FeatureSet> previous_;
+};
+
+}  // namespace
+
+std::unique_ptr<runtime::Node> makeOdometryNode(const Config& config) { return std::make_unique<OdometryNode>(config); }
+
+}  // namespace adit::nodes

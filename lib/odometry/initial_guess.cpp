@@ -1,0 +1,57 @@
+#include "odometry/initial_guess.hpp"
+
+#include "core/geometry.hpp"
+#include "features/deskew.hpp"
+#include "features/link3d_match.hpp"
+
+#include <cmath>
+
+namespace adit {
+
+InitialGuessConfig initialGuessConfigFrom(const Config& c) {
+  InitialGuessConfig g;
+  g.use_link3d = c.get("odometry.use_link3d_seed", g.use_link3d);
+  g.use_imu = c.get("odometry.use_imu_rotation", g.use_imu);
+  g.max_link3d_deviation_m = c.get("odometry.max_link3d_deviation_m", g.max_link3d_deviation_m);
+  g.max_link3d_deviation_deg = c.get("odometry.max_link3d_deviation_deg", g.max_link3d_deviation_deg);
+  const FeatureConfig features = featureConfigFrom(c);
+  g.link3d = features.link3d;
+  g.ransac = features.ransac;
+  g.R_lidar_imu = features.deskew.R_lidar_imu;
+  g.max_imu_gap_s = features.deskew.max_imu_gap_s;
+  return g;
+}
+
+InitialGuess initialGuess(const FeatureSet* previous, const FeatureSet& current, const Eigen::Isometry3d& motion_model,
+                          const std::vector<ImuSample>& imu, const InitialGuessConfig& config) {
+  InitialGuess guess;
+  if (!previous) return guess;
+  if (config.use_link3d && !previous->keypoints.empty() && !current.keypoints.empty()) {
+    const auto matches = matchLinK3d(*previous, current, config.link3d);
+    guess.link3d_matches = static_cast<int>(matches.size());
+    // p_prev = T_a_b * p_curr with a = previous, b = current: T_a_b is T_prev_curr.
+    const RansacResult r = estimateTransformRansac(previous->keypoints, current.keypoints, matches, config.ransac);
+    guess.link3d_inliers = static_cast<int>(r.inliers.size());
+    const Eigen::Isometry3d deviation = motion_model.inverse() * r.T_a_b;
+    if (r.ok && translationNorm(deviation) <= config.max_link3d_deviation_m &&
+        rotationAngle(deviation) <= config.max_link3d_deviation_deg * M_PI / 180.0) {
+      guess.T_prev_curr = r.T_a_b;
+      guess.flags = PoseEstimate::kSeededByLinK3d;
+      return guess;
+    }
+  }
+  if (config.use_imu && !imu.empty()) {
+    const double interval = toSeconds(current.utime - previous->utime);
+    const auto rotations = features::imuRotations(imu, current.utime, {-interval}, config.R_lidar_imu, config.max_imu_gap_s);
+    if (!rotations.empty()) {
+      // rotations[0]: the lidar at the previous sweep in the current frame, i.e. R_curr_prev.
+      Eigen::Isometry3d T = motion_model;
+      T.linear() = rotations.front().conjugate().toRotationMatrix();
+      guess.T_prev_curr = T;
+      guess.flags = PoseEstimate::kSeededByImu;
+    }
+  }
+  return guess;
+}
+
+}  // namespace adit
