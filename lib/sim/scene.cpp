@@ -446,31 +446,44 @@ Scene Scene::crop(const Eigen::AlignedBox3f& region) const {
   return out;
 }
 
+LocalRayCaster::LocalRayCaster(const Scene& scene) : scene_(&scene) {
+  crops_[0].half_size = 8.0f;  // most lidar rays in a roadway end within a few metres
+  crops_[0].cell = 2.0f;
+  crops_[1].half_size = 40.0f;  // rays along the roadway
+  crops_[1].cell = 10.0f;
+}
+
 void LocalRayCaster::moveTo(const Eigen::Vector3f& position) {
-  const Eigen::Vector3i key = (position / cell_).array().floor().cast<int>();
-  if (key == key_) return;
-  key_ = key;
-  const Eigen::Vector3f centre = (key.cast<float>().array() + 0.5f) * cell_;
-  region_ = Eigen::AlignedBox3f(centre - Eigen::Vector3f::Constant(half_size_), centre + Eigen::Vector3f::Constant(half_size_));
-  local_ = scene_->crop(region_);
+  for (Crop& crop : crops_) {
+    const Eigen::Vector3i key = (position / crop.cell).array().floor().cast<int>();
+    if (key == crop.key) continue;
+    crop.key = key;
+    const Eigen::Vector3f centre = (key.cast<float>().array() + 0.5f) * crop.cell;
+    const Eigen::Vector3f half = Eigen::Vector3f::Constant(crop.half_size);
+    crop.region = Eigen::AlignedBox3f(centre - half, centre + half);
+    crop.scene = scene_->crop(crop.region);
+  }
 }
 
 Hit LocalRayCaster::intersect(const Ray& ray, float t_min) const {
   const Eigen::Vector3f inv = safeInverse(ray.dir);
-  if (!region_.contains(ray.origin)) return scene_->intersect(ray, t_min, inv);
-  // Distance at which the ray leaves the crop region.
-  float t_exit = std::numeric_limits<float>::infinity();
-  for (int a = 0; a < 3; ++a) {
-    const float bound = ray.dir[a] > 0.0f ? region_.max()[a] : region_.min()[a];
-    t_exit = std::min(t_exit, (bound - ray.origin[a]) * inv[a]);
+  for (const Crop& crop : crops_) {
+    if (!crop.region.contains(ray.origin)) continue;
+    // Distance at which the ray leaves the crop region.
+    float t_exit = std::numeric_limits<float>::infinity();
+    for (int a = 0; a < 3; ++a) {
+      const float bound = ray.dir[a] > 0.0f ? crop.region.max()[a] : crop.region.min()[a];
+      t_exit = std::min(t_exit, (bound - ray.origin[a]) * inv[a]);
+    }
+    Ray local_ray = ray;
+    local_ray.t_max = std::min(ray.t_max, t_exit);
+    const Hit hit = crop.scene.intersect(local_ray, t_min, inv);
+    // A hit inside the region is the nearest: anything nearer lies in the region, hence in the crop.
+    if (hit.valid() || t_exit >= ray.t_max) return hit;
+    // Nothing before the exit: only hits beyond it remain (a small overlap guards against rounding).
+    t_min = std::max(t_min, t_exit - 1e-3f);
   }
-  Ray local_ray = ray;
-  local_ray.t_max = std::min(ray.t_max, t_exit);
-  const Hit hit = local_.intersect(local_ray, t_min, inv);
-  // A hit inside the region is the nearest: anything nearer lies in the region, hence in the crop.
-  if (hit.valid() || t_exit >= ray.t_max) return hit;
-  // Nothing before the exit: only hits beyond it remain (a small overlap guards against rounding).
-  return scene_->intersect(ray, std::max(t_min, t_exit - 1e-3f), inv);
+  return scene_->intersect(ray, t_min, inv);
 }
 
 }  // namespace adit::sim

@@ -120,25 +120,28 @@ class Scene {
   Eigen::AlignedBox3f bounds_;
 };
 
-// Exact nearest-hit queries for rays that start near one place (a lidar during a sweep): a cropped copy of the
-// scene around a cell answers the many short rays cheaply; rays leaving the crop fall back to the whole scene.
-// The crop depends only on the cell of the query position (cells of `cell` metres), never on the query history,
-// so results are a pure function of the inputs.
+// Exact nearest-hit queries for rays that start near one place (a lidar during a sweep): cropped copies of the
+// scene around the query position answer most rays with a small BVH. Two nested crops (a near one for the many
+// short rays, a far one for the rays along the roadway), then the whole scene for what leaves both. A crop
+// depends only on the cell of the query position, never on the query history, so results are a pure function
+// of the inputs.
 class LocalRayCaster {
  public:
-  explicit LocalRayCaster(const Scene& scene, float half_size = 8.0f, float cell = 2.0f)
-      : scene_(&scene), half_size_(half_size), cell_(cell) {}
-  // Selects the crop for rays starting near `position` (rebuilds it if the cell changed).
+  explicit LocalRayCaster(const Scene& scene);
+  // Selects the crops for rays starting near `position` (rebuilds a crop when its cell changed).
   void moveTo(const Eigen::Vector3f& position);
   // Same answer as Scene::intersect on the whole scene (up to exact ties between coincident surfaces).
   Hit intersect(const Ray& ray, float t_min = 1e-4f) const;
 
  private:
+  struct Crop {
+    float half_size, cell;  // m: the crop is the cube of this half size around the centre of the cell
+    Eigen::Vector3i key = Eigen::Vector3i::Constant(std::numeric_limits<int>::min());
+    Eigen::AlignedBox3f region;
+    Scene scene;
+  };
   const Scene* scene_;
-  float half_size_, cell_;
-  Eigen::Vector3i key_ = Eigen::Vector3i::Constant(std::numeric_limits<int>::min());
-  Eigen::AlignedBox3f region_;
-  Scene local_;
+  Crop crops_[2];
 };
 
 }  // namespace adit::sim
