@@ -67,10 +67,8 @@ Eigen::Isometry3d ScanToScanOdometry::predictMotion(std::int64_t utime) const {
 
 std::optional<LineFit> ScanToScanOdometry::fitLocalLine(const Eigen::Vector3d& q, double max_sq) const {
   // The nearest previous edge point and the nearest on each ring within ring_window of it: one point per
-  // ring, so the line follows the edge across rings. A-LOAM takes two (the nearest and one on another ring);
-  // requiring line_min_rings of them to be collinear rejects the "edges" that are only where a ring crosses a
-  // curvature change (floor-wall junction, arch springing): those move with the sensor and, matched as A-LOAM
-  // does, pull the motion estimate towards zero in tunnels.
+  // ring, so the line follows the edge across rings. With line_min_rings = 2 the line runs through the
+  // nearest point and the nearest point on another ring (A-LOAM); more rings must also be collinear.
   const int j = prev_corners_.nearest(q, max_sq);
   if (j < 0) return std::nullopt;
   const int ring = prev_corners_.ring(j);
@@ -81,8 +79,11 @@ std::optional<LineFit> ScanToScanOdometry::fitLocalLine(const Eigen::Vector3d& q
     if (k >= 0) pts.push_back(prev_corners_.point(k));
   }
   if (static_cast<int>(pts.size()) < std::max(2, config_.line_min_rings)) return std::nullopt;
-  if (pts.size() == 2) {  // A-LOAM's two-point line
-    const Eigen::Vector3d d = pts[1] - pts[0];
+  if (config_.line_min_rings <= 2) {  // A-LOAM's two-point line: the nearest and the closest other-ring point
+    std::size_t best = 1;
+    for (std::size_t i = 2; i < pts.size(); ++i)
+      if ((pts[i] - q).squaredNorm() < (pts[best] - q).squaredNorm()) best = i;
+    const Eigen::Vector3d d = pts[best] - pts[0];
     if (d.norm() < 1e-3) return std::nullopt;
     return LineFit{pts[0], d.normalized()};
   }
