@@ -50,7 +50,8 @@ struct SimConfig {
 
 // Keys: sim.world, sim.sensor, sim.duration, sim.seed, sim.start_utime, sim.dust (shortcut for sim.lidar.dust),
 // sim.roadway.* (WorldConfig fields), sim.motion.* (MotionConfig), sim.lidar.* (LidarNoiseConfig),
-// sim.imu.* (ImuConfig); every default as documented on the structs.
+// sim.imu.* (ImuConfig); every default as documented on the structs (launch/worlds/roadway-loop.yaml lists them
+// all). Throws std::invalid_argument for an unknown world, std::runtime_error for a value that does not parse.
 SimConfig simConfigFrom(const adit::Config& c);
 
 struct SimEvent {
