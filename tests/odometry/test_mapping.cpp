@@ -101,7 +101,7 @@ TEST(Mapper, GlobalMapIsDownsampledAndDeterministic) {
   ScanToMapMapper a, b;
   drive(a, 5, 0.5);
   drive(b, 5, 0.5);
-  const auto fine = a.globalMap(0.1), coarse = a.globalMap(0.5), again = b.globalMap(0.1);
+  const auto fine = a.globalMap(0.1), coarse = a.globalMap(0.8), again = b.globalMap(0.1);  // 0.1: stored 0.2
   EXPECT_GT(fine.size(), 1000u);
   EXPECT_LT(coarse.size(), fine.size() / 4);
   ASSERT_EQ(fine.size(), again.size());
