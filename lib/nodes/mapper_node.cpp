@@ -3,6 +3,7 @@
 #include "core/geometry.hpp"
 #include "eval/trajectory_io.hpp"
 #include "io/pcd.hpp"
+#include "features/preprocess.hpp"
 #include "mapping/scan_to_map.hpp"
 #include "msg/convert.hpp"
 #include "nodes/products.hpp"
@@ -21,7 +22,10 @@ class MapperNode : public runtime::Node, public WritesProducts {
   explicit MapperNode(const Config& config)
       : Node("mapper"), mapper_(mapperConfigFrom(config)),
         map_voxel_(config.get<double>("mapping.node.map_voxel", 0.1)),
-        map_path_(config.get<std::string>("mapping.node.map_path", "")) {
+        map_path_(config.get<std::string>("mapping.node.map_path", "")),
+        // ODOM_MAPPED carries the sweep for the loop closer's keyframes, which it thins to 0.2 m itself
+        // (loop.keyframe_voxel); keep this at or below that. 0 = forward it whole.
+        forward_voxel_(config.get<double>("mapping.node.forward_cloud_voxel", 0.2)) {
     subscribe<adit::odometry_t>("odometry", "ODOM_SCAN", [this](const adit::odometry_t& m) { onOdometry(m); });
     subscribe<adit::pose_graph_t>("graph", "POSE_GRAPH", [this](const adit::pose_graph_t& m) { onGraph(m); });
     subscribe<adit::command_t>("command", "MAPPER_COMMAND", [this](const adit::command_t& m) { onCommand(m); });
@@ -46,8 +50,13 @@ class MapperNode : public runtime::Node, public WritesProducts {
 
  private:
   void onOdometry(const adit::odometry_t& m) {
-    const FeatureSet features = msg::fromMessage(m.features);
+    FeatureSet features = msg::fromMessage(m.features);
     const PoseEstimate mapped = mapper_.process(features, msg::fromMessage(m));
+    // The loop closer needs the pose, the sweep and the keypoints, not the LOAM sets.
+    features.corner_less_sharp.clear();
+    features.surf_less_flat.clear();
+    if (forward_voxel_ > 0)
+      features.cloud.points = features::voxelDownsample(features.cloud.points, static_cast<float>(forward_voxel_));
     if (mapped.flags & PoseEstimate::kRegistrationFailed) count("registration_failed");
     if (mapped.flags & PoseEstimate::kDegenerateTranslation) count("degenerate_translation");
     if (mapped.flags & PoseEstimate::kDegenerateRotation) count("degenerate_rotation");
@@ -92,6 +101,7 @@ class MapperNode : public runtime::Node, public WritesProducts {
   ScanToMapMapper mapper_;
   double map_voxel_;
   std::string map_path_;
+  double forward_voxel_;
   Eigen::Isometry3d applied_ = Eigen::Isometry3d::Identity();  // total loop correction applied so far
   Trajectory corrected_, uncorrected_;
 };

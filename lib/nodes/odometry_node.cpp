@@ -1,5 +1,6 @@
 #include "nodes/odometry_node.hpp"
 
+#include "features/preprocess.hpp"
 #include "msg/convert.hpp"
 #include "odometry/initial_guess.hpp"
 #include "odometry/scan_to_scan.hpp"
@@ -15,6 +16,9 @@ class OdometryNode : public runtime::Node {
   explicit OdometryNode(const Config& config)
       : Node("odometry"), odometry_(scanToScanConfigFrom(config)), guess_config_(initialGuessConfigFrom(config)) {
     imu_keep_s_ = config.get<double>("odometry.node.imu_keep_s", 1.0);
+    // The sweep forwarded on ODOM_SCAN feeds only the mapper's global map (itself at 0.1 m): thin it to
+    // that resolution so the bus and the logs carry a third of the bytes. 0 = forward it whole.
+    forward_voxel_ = config.get<double>("odometry.node.forward_cloud_voxel", 0.1);
     subscribe<adit::features_t>("features", "FEATURES", [this](const adit::features_t& m) { onFeatures(m); });
     subscribe<adit::imu_t>("imu", "IMU", [this](const adit::imu_t& m) { onImu(m); });
     advertise("odometry", "ODOM_SCAN");
@@ -47,14 +51,19 @@ class OdometryNode : public runtime::Node {
     const PoseEstimate pose = odometry_.process(features, guess.T_prev_curr, guess.flags);
     if (pose.flags & PoseEstimate::kRegistrationFailed) count("registration_failed");
     if (pose.flags & PoseEstimate::kDegenerateTranslation) count("degenerate_translation");
+    previous_ = features;
+    // Downstream needs neither the odometry-only sets nor the full-density sweep.
+    features.corner_sharp.clear();
+    features.surf_flat.clear();
+    if (forward_voxel_ > 0)
+      features.cloud.points = features::voxelDownsample(features.cloud.points, static_cast<float>(forward_voxel_));
     adit::odometry_t out = msg::toMessage(pose, &features);
     publish("odometry", out);
-    previous_ = std::move(features);
   }
 
   ScanToScanOdometry odometry_;
   InitialGuessConfig guess_config_;
-  double imu_keep_s_ = 1.0;
+  double imu_keep_s_ = 1.0, forward_voxel_ = 0.1;
   std::deque<ImuSample> imu_;
   std::optional<FeatureSet> previous_;
 };

@@ -15,6 +15,7 @@
 #include <filesystem>
 #include <fstream>
 #include <memory>
+#include <regex>
 
 namespace adit::pipeline {
 namespace fs = std::filesystem;
@@ -73,7 +74,12 @@ ReplayReport runReplay(const ReplayOptions& options) {
 
   runtime::LogReader input(options.input_log);
   runtime::LogWriter output((fs::path(options.out_dir) / "output.lcmlog").string());
-  runtime::LockstepBus bus(&output);
+  // The bus logs nothing itself: this observer writes the recorded channels.
+  runtime::LockstepBus bus;
+  const std::regex record(options.record);
+  bus.observe([&](const std::string& channel, const runtime::Bytes& data, std::int64_t utime) {
+    if (std::regex_match(channel, record)) output.write(channel, data, utime);
+  });
   for (auto& node : nodes) bus.add(*node);
 
   runtime::LogEvent event;

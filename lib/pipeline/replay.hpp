@@ -21,6 +21,7 @@ struct ReplayOptions {
   std::string out_dir;
   Config config;
   std::vector<std::string> stages;  // empty: every stage that is written
+  std::string record = ".*";        // regex of the channels written to output.lcmlog
   // Called now and then with the fraction of the input consumed (progress bars).
   std::function<void(double)> on_progress;
 };

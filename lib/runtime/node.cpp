@@ -43,7 +43,7 @@ void Node::deliver(const std::string& channel, const std::uint8_t* data, std::si
       reportError("stage_exception", std::string("stage failed on ") + channel + ": " + e.what());
     }
     const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-    timing_.add(ms);
+    if (kv.first == primary_port_) timing_.add(ms);
     health_.busy_s += ms * 1e-3;
     sink_ = nullptr;
   }

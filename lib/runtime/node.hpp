@@ -48,6 +48,7 @@ class Node {
   void finish(Sink& sink);
 
   const Health& health() const { return health_; }
+  // Processing time of the node's first input (its main one: a sweep, not the IMU samples in between).
   const TimingWindow& timing() const { return timing_; }
   TimingWindow& timing() { return timing_; }
   // A short word for STATUS ("running", "behind", ...); subclasses may refine it.
@@ -91,6 +92,7 @@ class Node {
   std::string name_;
   std::map<std::string, std::string> channels_;  // port -> channel
   std::map<std::string, Input> inputs_;          // port -> input
+  std::string primary_port_;                     // the first port subscribed: what timing() measures
   std::map<std::string, std::int64_t> seq_;      // output port -> next sequence number
   Health health_;
   TimingWindow timing_;
@@ -102,6 +104,7 @@ template <class Msg>
 void Node::subscribe(const std::string& port, const std::string& default_channel,
                      std::function<void(const Msg&)> handler) {
   channels_.emplace(port, default_channel);
+  if (primary_port_.empty()) primary_port_ = port;
   Input input;
   input.port = port;
   input.handle = [this, port, handler = std::move(handler)](const std::uint8_t* data, std::size_t size) {

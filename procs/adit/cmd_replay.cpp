@@ -16,6 +16,7 @@ struct ReplayArgs {
   std::string log, out_dir;
   std::vector<std::string> configs;
   std::vector<std::string> stages;
+  std::string record = ".*";
   bool no_progress = false;
 };
 
@@ -40,6 +41,7 @@ void registerReplayCommand(CLI::App& app) {
                   "YAML configuration, repeatable, later files override (default: built-in defaults, listed in "
                   "launch/config/pipeline.yaml)");
   cmd->add_option("--stages", args->stages, "Only these stages (feature odometry mapper loop_closer)");
+  cmd->add_option("--record", args->record, "Regex of the channels written to output.lcmlog (default: all)");
   cmd->add_flag("--no-progress", args->no_progress, "No progress bar even on a terminal");
   cmd->callback([args] {
     adit::pipeline::ReplayOptions options;
@@ -47,6 +49,7 @@ void registerReplayCommand(CLI::App& app) {
     options.out_dir = args->out_dir;
     options.config = adit::runtime::loadConfig(args->configs);
     options.stages = args->stages;
+    options.record = args->record;
     if (!args->no_progress && ::isatty(STDERR_FILENO)) options.on_progress = drawProgress;
     adit::runtime::installStopHandlers();
     const auto r = adit::pipeline::runReplay(options);
