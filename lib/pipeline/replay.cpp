@@ -7,6 +7,7 @@
 #include "runtime/lcm_log.hpp"
 #include "runtime/lockstep.hpp"
 #include "runtime/process.hpp"
+#include "runtime/source.hpp"
 
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
@@ -72,7 +73,8 @@ ReplayReport runReplay(const ReplayOptions& options) {
     }
   }
 
-  runtime::LogReader input(options.input_log);
+  std::unique_ptr<runtime::LogReader> log;
+  if (!options.source) log = std::make_unique<runtime::LogReader>(options.input_log);
   runtime::LogWriter output((fs::path(options.out_dir) / "output.lcmlog").string());
   // The bus logs nothing itself: this observer writes the recorded channels.
   runtime::LockstepBus bus;
@@ -83,21 +85,33 @@ ReplayReport runReplay(const ReplayOptions& options) {
   for (auto& node : nodes) bus.add(*node);
 
   runtime::LogEvent event;
+  runtime::OutgoingMessage message;
+  const auto next = [&]() {
+    if (log) return log->next(event);
+    if (!options.source->next(message)) return false;
+    event.channel = std::move(message.channel);
+    event.data = std::move(message.data);
+    event.timestamp = message.utime;
+    return true;
+  };
   std::int64_t first_utime = -1, last_utime = -1;
-  while (!runtime::stopRequested() && input.next(event)) {
+  while (!runtime::stopRequested() && next()) {
     ++report.input_events;
     if (msg::messageTypeName(event.data.data(), event.data.size()) == "point_cloud_t") ++report.sweeps;
     if (first_utime < 0) first_utime = event.timestamp;
     last_utime = std::max(last_utime, event.timestamp);
     bus.inject(event.channel, event.data, event.timestamp);
-    if (options.on_progress && report.input_events % 64 == 0) options.on_progress(input.progress());
+    if (options.on_progress && report.input_events % 64 == 0) {
+      const double fraction = log ? log->progress() : options.source->progress();
+      if (fraction >= 0) options.on_progress(fraction);
+    }
   }
   bus.finish();
   output.close();
   if (options.on_progress) options.on_progress(1.0);
 
-  report.corrupt_frames = input.corruptFrames();
-  report.truncated = input.truncated();
+  report.corrupt_frames = log ? log->corruptFrames() : 0;
+  report.truncated = log && log->truncated();
   report.output_events = output.events();
   report.products.push_back(output.path());
   for (const auto& node : nodes) {

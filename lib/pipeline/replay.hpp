@@ -14,10 +14,16 @@
 #include <string>
 #include <vector>
 
-namespace adit::pipeline {
+namespace adit {
+namespace runtime {
+class MessageSource;
+}
+namespace pipeline {
 
 struct ReplayOptions {
   std::string input_log;
+  // Instead of a log: messages straight from a source (the simulator), no intermediate file.
+  runtime::MessageSource* source = nullptr;
   std::string out_dir;
   Config config;
   std::vector<std::string> stages;  // empty: every stage that is written
@@ -54,4 +60,5 @@ ReplayReport runReplay(const ReplayOptions& options);
 // Peak resident memory of this process in MB (VmHWM), 0 if unknown.
 double peakMemoryMb();
 
-}  // namespace adit::pipeline
+}  // namespace pipeline
+}  // namespace adit

@@ -23,6 +23,8 @@ class MessageSource {
   // Next message in time order; false at the end. Recoverable problems are counted in health().
   virtual bool next(OutgoingMessage& message) = 0;
   virtual const Health& health() const = 0;
+  // Fraction of the input produced so far, or < 0 if unknown (a live sensor).
+  virtual double progress() const { return -1.0; }
 
   // A source that waits for input (a live sensor) calls the hook about every 100 ms while nothing
   // arrives, so the runner keeps publishing STATUS while the sensor is silent.

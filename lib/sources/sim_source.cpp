@@ -17,6 +17,11 @@ runtime::Bytes encode(Msg& m) {
 SimSource::SimSource(const sim::SimConfig& config, SimChannels channels)
     : simulator_(config), channels_(std::move(channels)) {}
 
+double SimSource::progress() const {
+  const auto total = simulator_.numSweeps();
+  return total > 0 ? static_cast<double>(truth_.size()) / static_cast<double>(total) : 1.0;
+}
+
 bool SimSource::next(runtime::OutgoingMessage& out) {
   if (pending_truth_) {
     out = std::move(*pending_truth_);

@@ -21,6 +21,7 @@ class SimSource : public runtime::MessageSource {
   SimSource(const sim::SimConfig& config, SimChannels channels);
   bool next(runtime::OutgoingMessage& message) override;
   const runtime::Health& health() const override { return health_; }
+  double progress() const override;
 
   const sim::Simulator& simulator() const { return simulator_; }
   // T_world_lidar at each sweep's utime (its last firing), in the order published.

@@ -20,15 +20,6 @@ struct ReplayArgs {
   bool no_progress = false;
 };
 
-void drawProgress(double fraction) {
-  const int width = 40;
-  const int filled = static_cast<int>(fraction * width + 0.5);
-  std::fprintf(stderr, "\r[%s%s] %3d%%", std::string(static_cast<std::size_t>(filled), '#').c_str(),
-               std::string(static_cast<std::size_t>(width - filled), ' ').c_str(), static_cast<int>(fraction * 100 + 0.5));
-  if (fraction >= 1.0) std::fprintf(stderr, "\n");
-  std::fflush(stderr);
-}
-
 }  // namespace
 
 void registerReplayCommand(CLI::App& app) {

@@ -14,5 +14,9 @@ void registerLaunchCommand(CLI::App& app);
 void registerSpyCommand(CLI::App& app);
 void registerEvalCommand(CLI::App& app);
 
+void registerDemoCommand(CLI::App& app);
+
 // Folder of the running executable (build/bin), to find sibling programs and build/share.
 std::string executableDir();
+// A progress bar on stderr (call with 0..1; 1 ends the line).
+void drawProgress(double fraction);

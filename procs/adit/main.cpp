@@ -4,12 +4,22 @@
 
 #include <spdlog/spdlog.h>
 
+#include <cstdio>
 #include <filesystem>
 
 std::string executableDir() {
   std::error_code ec;
   const auto exe = std::filesystem::read_symlink("/proc/self/exe", ec);
   return ec ? std::string(".") : exe.parent_path().string();
+}
+
+void drawProgress(double fraction) {
+  const int width = 40;
+  const int filled = static_cast<int>(fraction * width + 0.5);
+  std::fprintf(stderr, "\r[%s%s] %3d%%", std::string(static_cast<std::size_t>(filled), '#').c_str(),
+               std::string(static_cast<std::size_t>(width - filled), ' ').c_str(), static_cast<int>(fraction * 100 + 0.5));
+  if (fraction >= 1.0) std::fprintf(stderr, "\n");
+  std::fflush(stderr);
 }
 
 int main(int argc, char** argv) {
@@ -20,6 +30,7 @@ int main(int argc, char** argv) {
   registerInfoCommand(app);
   registerConfigCommand(app);
   registerSimCommand(app);
+  registerDemoCommand(app);
   registerReplayCommand(app);
   registerLaunchCommand(app);
   registerSpyCommand(app);
