@@ -42,17 +42,18 @@ Matrix6d covarianceFrom(const Matrix6d& information, const DegeneracyReport& rep
   const double prior_r = 1.0 / (prior_sigma_rotation_rad * prior_sigma_rotation_rad);
   Matrix6d info = information.allFinite() ? information : Matrix6d::Zero();
   info = 0.5 * (info + info.transpose()).eval();
-  // Replace the information along each degenerate direction by the prior's.
+  // Replace the information along each degenerate direction by the prior's: what was measured there is too
+  // weak (or, with edges on curved walls, not trustworthy) to report.
   for (int i = 0; i < 3; ++i) {
     if (report.translation_degenerate[i]) {
       const Eigen::Vector3d v = report.translation_directions.col(i);
       const double measured = v.dot(info.topLeftCorner<3, 3>() * v);
-      info.topLeftCorner<3, 3>() += (prior_t - std::min(measured, prior_t)) * v * v.transpose();
+      info.topLeftCorner<3, 3>() += (prior_t - measured) * v * v.transpose();
     }
     if (report.rotation_degenerate[i]) {
       const Eigen::Vector3d v = report.rotation_directions.col(i);
       const double measured = v.dot(info.bottomRightCorner<3, 3>() * v);
-      info.bottomRightCorner<3, 3>() += (prior_r - std::min(measured, prior_r)) * v * v.transpose();
+      info.bottomRightCorner<3, 3>() += (prior_r - measured) * v * v.transpose();
     }
   }
   // A floor of the prior information on the diagonal's scale keeps the inverse defined even when the

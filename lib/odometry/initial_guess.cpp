@@ -10,6 +10,8 @@ namespace adit {
 
 InitialGuessConfig initialGuessConfigFrom(const Config& c) {
   InitialGuessConfig g;
+  // Plain A-LOAM (the ablation baseline) seeds from its motion model only.
+  if (c.get("ablation.aloam", false)) g.use_link3d = g.use_imu = false;
   g.use_link3d = c.get("odometry.use_link3d_seed", g.use_link3d);
   g.use_imu = c.get("odometry.use_imu_rotation", g.use_imu);
   g.max_link3d_deviation_m = c.get("odometry.max_link3d_deviation_m", g.max_link3d_deviation_m);

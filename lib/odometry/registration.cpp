@@ -86,6 +86,7 @@ RegistrationConfig registrationConfigFrom(const Config& c, const std::string& pr
   r.degeneracy_ratio_translation = c.get<double>(key("degeneracy_ratio_translation"), r.degeneracy_ratio_translation);
   r.degeneracy_ratio_rotation = c.get<double>(key("degeneracy_ratio_rotation"), r.degeneracy_ratio_rotation);
   r.degeneracy_prior = c.get<bool>(key("degeneracy_prior"), r.degeneracy_prior);
+  r.degeneracy_from_planes_only = c.get<bool>(key("degeneracy_from_planes_only"), r.degeneracy_from_planes_only);
   r.degeneracy_prior_strength = c.get<double>(key("degeneracy_prior_strength"), r.degeneracy_prior_strength);
   r.prior_sigma_translation_m = c.get<double>(key("prior_sigma_translation_m"), r.prior_sigma_translation_m);
   r.prior_sigma_rotation_rad = c.get<double>(key("prior_sigma_rotation_rad"), r.prior_sigma_rotation_rad);
@@ -105,9 +106,11 @@ RegistrationResult registerStep(const Correspondences& matches, const Eigen::Iso
   ceres::Problem problem(problem_options);
   const std::unique_ptr<ceres::LossFunction> loss = makeLoss(config);
   const auto ids = addMeasurements(problem, xi, matches, T0, loss.get());
+  const std::vector<ceres::ResidualBlockId> plane_ids(ids.begin() + static_cast<long>(matches.lines.size()), ids.end());
+  const auto& degeneracy_ids = config.degeneracy_from_planes_only ? plane_ids : ids;
 
   // Degeneracy at the linearisation point decides where the motion prior applies during this round.
-  const Matrix6d H0 = informationOf(problem, ids, config.point_sigma_m);
+  const Matrix6d H0 = informationOf(problem, degeneracy_ids, config.point_sigma_m);
   const DegeneracyReport d0 = analyzeDegeneracy(H0, config.degeneracy_ratio_translation, config.degeneracy_ratio_rotation);
   if (config.degeneracy_prior && d0.flags != 0 && isFinitePose(motion_prior))
     addDirectionalPriors(problem, xi, d0, incrementBetween(T0, motion_prior), config);
@@ -125,8 +128,9 @@ RegistrationResult registerStep(const Correspondences& matches, const Eigen::Iso
   if (!solution.allFinite()) return result;
   // Report information and degeneracy at the solution, from the measurements only.
   result.information = informationOf(problem, ids, config.point_sigma_m);
-  result.degeneracy = analyzeDegeneracy(result.information, config.degeneracy_ratio_translation,
-                                        config.degeneracy_ratio_rotation);
+  const Matrix6d H = config.degeneracy_from_planes_only ? informationOf(problem, plane_ids, config.point_sigma_m)
+                                                        : result.information;
+  result.degeneracy = analyzeDegeneracy(H, config.degeneracy_ratio_translation, config.degeneracy_ratio_rotation);
   result.pose = applyIncrement(T0, solution);
   result.iterations = static_cast<int>(summary.iterations.size());
   result.final_cost = summary.final_cost;

@@ -58,10 +58,14 @@ ScanToScanOdometry::ScanToScanOdometry(ScanToScanConfig config) : config_(std::m
 
 void ScanToScanOdometry::reset() { *this = ScanToScanOdometry(config_); }
 
+bool ScanToScanOdometry::hasVelocity(std::int64_t utime) const {
+  const std::int64_t gap = utime - previous_utime_;
+  return has_previous_ && last_gap_us_ > 0 && gap > 0 && toSeconds(gap) <= config_.max_velocity_gap_s;
+}
+
 Eigen::Isometry3d ScanToScanOdometry::predictMotion(std::int64_t utime) const {
   const std::int64_t gap = utime - previous_utime_;
-  if (!has_previous_ || last_gap_us_ <= 0 || gap <= 0 || toSeconds(gap) > config_.max_velocity_gap_s)
-    return Eigen::Isometry3d::Identity();
+  if (!hasVelocity(utime)) return Eigen::Isometry3d::Identity();
   return scaleMotion(last_motion_, static_cast<double>(gap) / static_cast<double>(last_gap_us_));
 }
 
@@ -151,12 +155,14 @@ Correspondences ScanToScanOdometry::match(const std::vector<LidarPoint>& sharp, 
 }
 
 ScanToScanOdometry::Refinement ScanToScanOdometry::refine(const SweepPoints& cur, const Eigen::Isometry3d& seed,
-                                                         const Eigen::Isometry3d& hold) const {
+                                                         const Eigen::Isometry3d& hold, bool can_hold) const {
+  RegistrationConfig registration = config_.registration;
+  registration.degeneracy_prior = registration.degeneracy_prior && can_hold;
   Refinement out;
   out.pose = seed;
   out.ok = true;
   for (int round = 0; round < std::max(1, config_.outer_iterations); ++round) {
-    out.result = registerStep(match(cur.sharp, cur.flat, out.pose), out.pose, hold, config_.registration);
+    out.result = registerStep(match(cur.sharp, cur.flat, out.pose), out.pose, hold, registration);
     out.iterations += out.result.iterations;
     if (!(out.ok = out.result.ok)) break;
     const bool converged = hasConverged(out.pose, out.result.pose);
@@ -190,6 +196,9 @@ PoseEstimate ScanToScanOdometry::process(const FeatureSet& f, const std::optiona
   // to a LinK3D seed: that one is measured from the same, degenerate, geometry.
   const bool imu_prior = prior_usable && (prior_flags & PoseEstimate::kSeededByImu) != 0;
   const Eigen::Isometry3d hold = imu_prior ? *prior : motion_model;
+  // Before a velocity is known the motion model says nothing (its identity is not "standing still"):
+  // holding a degenerate direction to it would pin the estimate at zero motion.
+  const bool can_hold = imu_prior || hasVelocity(f.utime);
 
   SweepPoints cur{f.corner_sharp, f.surf_flat, f.corner_less_sharp, f.surf_less_flat};
   const bool cur_raw = !f.cloud.deskewed;
@@ -207,7 +216,7 @@ PoseEstimate ScanToScanOdometry::process(const FeatureSet& f, const std::optiona
       if (cur_raw) cur = fixed; else setPrevious(fixed);
     }
     const int iterations = r.iterations;
-    r = refine(cur, r.pose, hold);
+    r = refine(cur, r.pose, hold, can_hold);
     r.iterations += iterations;
     if (!r.ok) break;
   }

@@ -75,6 +75,8 @@ class ScanToScanOdometry {
 
   // Constant-velocity guess of T_prev_curr for a sweep at `utime` (identity before two sweeps were seen).
   Eigen::Isometry3d predictMotion(std::int64_t utime) const;
+  // True when predictMotion(utime) is an extrapolated velocity rather than the identity of ignorance.
+  bool hasVelocity(std::int64_t utime) const;
 
   // The correspondences of sharp / flat points against the previous sweep at a guess of T_prev_curr
   // (what one registration round uses; public for diagnostics and tests).
@@ -95,7 +97,8 @@ class ScanToScanOdometry {
     int iterations = 0;
   };
   // Outer rounds (correspondences recomputed each) from `seed` until converged or out of rounds.
-  Refinement refine(const SweepPoints& cur, const Eigen::Isometry3d& seed, const Eigen::Isometry3d& hold) const;
+  Refinement refine(const SweepPoints& cur, const Eigen::Isometry3d& seed, const Eigen::Isometry3d& hold,
+                    bool can_hold) const;
   void setPrevious(const SweepPoints& points);
   std::optional<LineFit> fitLocalLine(const Eigen::Vector3d& q, double max_sq) const;
   std::optional<PlaneFit> threePointPlane(const Eigen::Vector3d& q, double max_sq) const;
