@@ -21,4 +21,12 @@ std::unique_ptr<runtime::Node> makeNode(const std::string& name, const Config& c
   throw std::runtime_error("no pipeline node named '" + name + "'");
 }
 
+std::map<std::string, std::string> pipelineConfigKeys(const Config& config) {
+  std::map<std::string, std::string> reads;
+  config.recordReadsInto(&reads);
+  for (const auto& name : pipelineNodeNames()) makeNode(name, config);
+  config.recordReadsInto(nullptr);
+  return reads;
+}
+
 }  // namespace adit::nodes

@@ -4,6 +4,7 @@
 #include "core/config.hpp"
 #include "runtime/node.hpp"
 
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>
@@ -16,5 +17,9 @@ const std::vector<std::string>& pipelineNodeNames();
 // Builds a node from the whole configuration (it reads its own section). Throws
 // runtime::StageNotImplemented if that stage is not written yet, std::runtime_error on bad config.
 std::unique_ptr<runtime::Node> makeNode(const std::string& name, const Config& config);
+
+// Every configuration key the pipeline's nodes read, with the value they resolve to under `config`
+// (the built-in default where config does not set it).
+std::map<std::string, std::string> pipelineConfigKeys(const Config& config);
 
 }  // namespace adit::nodes

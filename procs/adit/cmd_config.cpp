@@ -35,23 +35,9 @@ void printYaml(const std::map<std::string, std::string>& values) {
 
 }  // namespace
 
-std::map<std::string, std::string> pipelineConfigKeys(const adit::Config& config) {
-  std::map<std::string, std::string> reads;
-  config.recordReadsInto(&reads);
-  for (const auto& name : adit::nodes::pipelineNodeNames()) {
-    try {
-      adit::nodes::makeNode(name, config);
-    } catch (const adit::runtime::StageNotImplemented&) {
-      // nothing to list for a stage that is not written
-    }
-  }
-  config.recordReadsInto(nullptr);
-  return reads;
-}
-
 void registerConfigCommand(CLI::App& app) {
   auto files = std::make_shared<std::vector<std::string>>();
   auto* cmd = app.add_subcommand("config", "Print every pipeline configuration key with the value in force, as YAML");
   cmd->add_option("--config", *files, "YAML files to apply over the defaults (repeatable)");
-  cmd->callback([files] { printYaml(pipelineConfigKeys(adit::runtime::loadConfig(*files))); });
+  cmd->callback([files] { printYaml(adit::nodes::pipelineConfigKeys(adit::runtime::loadConfig(*files))); });
 }
