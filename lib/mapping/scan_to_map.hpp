@@ -38,9 +38,9 @@ struct MapperConfig {
   // roadway returns are mostly within 50 m; KITTI needs ~80 m.
   double local_map_radius_m = 80.0;
   // Resolution of the saved global map (m) and the range of sweep points folded into it (m). The global map
-  // grows with the explored surface: measured 2700 cells per metre of simulated 16-beam roadway at 0.1 m
-  // (60 m range), about a quarter of that at 0.2 m; at ~50 bytes a cell a 30-minute, 2.3 km run holds
-  // ~100 MB at 0.2 m, ~300 MB at 0.1 m. Far 16-beam returns are sparse and noisy, hence the range limit.
+  // grows with the explored surface: measured 600 cells per metre of simulated 16-beam roadway at 0.2 m / 40 m
+  // (2700 at 0.1 m / 60 m); at ~50 bytes a cell a 30-minute, 2.3 km run holds ~70 MB. Far 16-beam returns
+  // are sparse and noisy, hence the range limit.
   double global_map_resolution_m = 0.2;
   double global_map_max_range_m = 40.0;
   // Compensate sweeps that arrive raw (not deskewed) with the odometry motion before they enter the map: a
