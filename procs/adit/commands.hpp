@@ -15,6 +15,7 @@ void registerSpyCommand(CLI::App& app);
 void registerEvalCommand(CLI::App& app);
 
 void registerDemoCommand(CLI::App& app);
+void registerBenchCommand(CLI::App& app);
 
 // Folder of the running executable (build/bin), to find sibling programs and build/share.
 std::string executableDir();

@@ -31,6 +31,7 @@ int main(int argc, char** argv) {
   registerConfigCommand(app);
   registerSimCommand(app);
   registerDemoCommand(app);
+  registerBenchCommand(app);
   registerReplayCommand(app);
   registerLaunchCommand(app);
   registerSpyCommand(app);

@@ -1,0 +1,135 @@
+// adit bench ablation <log> --gt <gt>: the paper's before/after comparison on one log, same binaries:
+//   (a) plain A-LOAM, (b) + LinK3D, (c) + LinK3D + Scan Context loop closure; one APE table.
+// adit bench pipeline [--sensor vlp16|hdl64] [--log LOG]: per-stage ms per sweep (median, p95), throughput,
+//   real-time factor and peak memory of the whole pipeline.
+#include "commands.hpp"
+
+#include "eval/report.hpp"
+#include "eval/trajectory_io.hpp"
+#include "pipeline/run_summary.hpp"
+#include "runtime/process.hpp"
+#include "sources/sim_source.hpp"
+
+#include <fmt/format.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct Variant {
+  std::string name;
+  std::vector<std::string> extra_configs;  // relative to launch/config
+  std::vector<std::string> stages;
+};
+
+const std::vector<Variant>& ablationVariants() {
+  static const std::vector<Variant> variants{
+      {"A-LOAM", {"aloam.yaml"}, {"feature", "odometry", "mapper"}},
+      {"+ LinK3D", {}, {"feature", "odometry", "mapper"}},
+      {"+ LinK3D + Scan Context", {}, {"feature", "odometry", "mapper", "loop_closer"}},
+  };
+  return variants;
+}
+
+fs::path aditRoot() { return fs::weakly_canonical(fs::path(executableDir()) / ".." / ".."); }
+
+void registerAblation(CLI::App& bench) {
+  struct Args {
+    std::string log, gt, out_dir;
+    std::vector<std::string> configs;
+  };
+  auto a = std::make_shared<Args>();
+  auto* cmd = bench.add_subcommand("ablation", "Run a log as plain A-LOAM, + LinK3D, + LinK3D + Scan Context; print the APE table");
+  cmd->add_option("log", a->log, "Input LCM log")->required()->check(CLI::ExistingFile);
+  cmd->add_option("--gt", a->gt, "Ground truth (TUM, T_world_lidar at the sweeps' utimes)")->required()->check(CLI::ExistingFile);
+  cmd->add_option("--config", a->configs, "Base configuration (default launch/config/pipeline.yaml; repeatable)");
+  cmd->add_option("-o,--out", a->out_dir, "Output folder, one sub-folder per variant (default <adit>/logs/ablation)");
+  cmd->callback([a] {
+    const fs::path root = aditRoot();
+    std::vector<std::string> base = a->configs;
+    if (base.empty()) base.push_back((root / "launch" / "config" / "pipeline.yaml").string());
+    const fs::path out = a->out_dir.empty() ? root / "logs" / "ablation" : fs::path(a->out_dir);
+    const adit::Trajectory gt = adit::eval::readTum(a->gt);
+    std::vector<adit::eval::ApeTableRow> rows;
+    std::string loops;
+    for (const Variant& v : ablationVariants()) {
+      std::vector<std::string> configs = base;
+      for (const auto& f : v.extra_configs) configs.push_back((root / "launch" / "config" / f).string());
+      adit::pipeline::ReplayOptions options;
+      options.input_log = a->log;
+      options.out_dir = (out / v.name.substr(v.name.find_first_not_of("+ "))).string();
+      for (char& c : options.out_dir) if (c == ' ' || c == '+') c = '_';
+      options.config = adit::runtime::loadConfig(configs);
+      options.stages = v.stages;
+      options.record = "^(LOOP_CLOSURE|POSE_GRAPH)$";
+      fmt::print("ablation: {} ...\n", v.name);
+      std::fflush(stdout);
+      const auto summary = adit::pipeline::summarizeRun(adit::pipeline::runReplay(options), options.out_dir, gt);
+      if (!summary.final_eval.valid) throw std::runtime_error(v.name + ": " + summary.final_eval.message);
+      rows.push_back({v.name, summary.final_eval.ape_m, summary.ms_per_sweep});
+      loops += fmt::format("  {}: {} loop(s) closed, output in {}\n", v.name, summary.loops, options.out_dir);
+    }
+    const std::string table = adit::eval::formatApeTable(rows, "APE (m) against ground truth, se3-aligned: " + a->log);
+    std::ofstream(out / "ablation.txt") << table << loops;
+    fmt::print("\n{}{}", table, loops);
+  });
+}
+
+void registerPipelineBench(CLI::App& bench) {
+  struct Args {
+    std::string sensor = "vlp16", log, world = "roadway-loop";
+    std::vector<std::string> configs;
+    double duration_s = 60;
+  };
+  auto a = std::make_shared<Args>();
+  auto* cmd = bench.add_subcommand("pipeline", "Time every stage over a simulated run (or a log): ms per sweep, throughput, memory");
+  cmd->add_option("--sensor", a->sensor, "Simulated sensor: vlp16 | rs16 | hdl64")->check(CLI::IsMember({"vlp16", "rs16", "hdl64"}));
+  cmd->add_option("--world", a->world, "Simulated world");
+  cmd->add_option("--duration", a->duration_s, "Simulated seconds")->check(CLI::PositiveNumber);
+  cmd->add_option("--log", a->log, "Time this log instead of a simulation")->check(CLI::ExistingFile);
+  cmd->add_option("--config", a->configs, "Configuration (default launch/config/pipeline.yaml)");
+  cmd->callback([a] {
+    const fs::path root = aditRoot();
+    std::vector<std::string> configs = a->configs;
+    if (configs.empty()) configs.push_back((root / "launch" / "config" / "pipeline.yaml").string());
+    adit::pipeline::ReplayOptions options;
+    options.config = adit::runtime::loadConfig(configs);
+    options.out_dir = (fs::temp_directory_path() / ("adit_bench_" + std::to_string(::getpid()))).string();
+    options.record = "^$";  // time the stages, not the disk
+    std::unique_ptr<adit::sources::SimSource> sim;
+    std::string input = a->log;
+    if (a->log.empty()) {
+      adit::sim::SimConfig s = adit::sim::simConfigFrom(options.config);
+      s.world = a->world;
+      s.sensor = a->sensor;
+      s.duration_s = a->duration_s;
+      sim = std::make_unique<adit::sources::SimSource>(s, adit::sources::SimChannels{});
+      options.source = sim.get();
+      input = fmt::format("simulated {} {} for {:.0f} s", a->world, a->sensor, a->duration_s);
+    } else {
+      options.input_log = a->log;
+    }
+    const auto r = adit::pipeline::runReplay(options);
+    fs::remove_all(options.out_dir);
+    fmt::print("pipeline benchmark: {} ({} sweeps), one thread\n", input, r.sweeps);
+    fmt::print("  {:<12} {:>10} {:>10} {:>10}\n", "stage", "median ms", "p95 ms", "max ms");
+    for (const auto& t : r.timing) fmt::print("  {:<12} {:>10.2f} {:>10.2f} {:>10.2f}\n", t.stage, t.median_ms, t.p95_ms, t.max_ms);
+    const double per_sweep = r.sweeps ? r.wall_seconds * 1e3 / static_cast<double>(r.sweeps) : 0.0;
+    fmt::print("  end to end: {:.1f} ms per sweep (incl. simulation when simulated), {:.1f} sweeps/s, {:.1f}x real time, "
+               "peak memory {:.0f} MB\n", per_sweep, per_sweep > 0 ? 1e3 / per_sweep : 0.0,
+               r.wall_seconds > 0 ? r.sensor_seconds / r.wall_seconds : 0.0, r.peak_memory_mb);
+  });
+}
+
+}  // namespace
+
+void registerBenchCommand(CLI::App& app) {
+  auto* bench = app.add_subcommand("bench", "Benchmarks: the ablation table and the pipeline's speed");
+  bench->require_subcommand(1);
+  registerAblation(*bench);
+  registerPipelineBench(*bench);
+}
