@@ -27,8 +27,10 @@ class MapperNode : public runtime::Node, public WritesProducts {
         // (loop.keyframe_voxel); keep this at or below that. 0 = forward it whole.
         forward_voxel_(config.get<double>("mapping.node.forward_cloud_voxel", 0.2)) {
     subscribe<adit::odometry_t>("odometry", "ODOM_SCAN", [this](const adit::odometry_t& m) { onOdometry(m); });
-    subscribe<adit::pose_graph_t>("graph", "POSE_GRAPH", [this](const adit::pose_graph_t& m) { onGraph(m); });
-    subscribe<adit::command_t>("command", "MAPPER_COMMAND", [this](const adit::command_t& m) { onCommand(m); });
+    subscribe<adit::pose_graph_t>("graph", "POSE_GRAPH", [this](const adit::pose_graph_t& m) { onGraph(m); },
+                                  runtime::InputKind::Events);
+    subscribe<adit::command_t>("command", "MAPPER_COMMAND", [this](const adit::command_t& m) { onCommand(m); },
+                               runtime::InputKind::Requests);
     advertise("mapped", "ODOM_MAPPED");
   }
 

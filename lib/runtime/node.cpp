@@ -69,13 +69,14 @@ bool Node::admit(Input& input, std::int64_t utime, std::int64_t seq) {
                  seq - input.last_seq - 1, seq, input.last_seq);
   }
   if (seq >= 0) input.last_seq = seq;
+  if (input.kind == InputKind::Requests) return true;
   if (input.last_utime >= 0 && utime <= input.last_utime) {
     reportDrop(utime == input.last_utime ? "duplicate_time" : "time_backwards",
                channel + ": utime " + std::to_string(utime) + " is not after " + std::to_string(input.last_utime) +
                    ": skipped");
     return false;
   }
-  if (input.last_utime >= 0 && utime - input.last_utime > max_time_gap_us_) {
+  if (input.kind == InputKind::Stream && input.last_utime >= 0 && utime - input.last_utime > max_time_gap_us_) {
     count("time_jump");
     spdlog::warn("[{}] {}: time jumps forward by {:.3f} s: resetting temporal state", name_, channel,
                  static_cast<double>(utime - input.last_utime) * 1e-6);

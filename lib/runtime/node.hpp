@@ -20,6 +20,13 @@ namespace adit::runtime {
 
 using Bytes = std::vector<std::uint8_t>;
 
+// How an input's timing is checked before its handler runs.
+enum class InputKind {
+  Stream,    // sensor data at a steady rate: time must advance; a forward gap is a time jump
+  Events,    // sparse results (loop closures, graphs): time must advance; gaps are normal
+  Requests,  // commands: no time checks
+};
+
 // Where a node's output goes (LCM in a process, the in-process bus in replay).
 class Sink {
  public:
@@ -60,7 +67,8 @@ class Node {
  protected:
   // Declare an input port. Handler is called with the decoded message, in arrival order.
   template <class Msg>
-  void subscribe(const std::string& port, const std::string& default_channel, std::function<void(const Msg&)> handler);
+  void subscribe(const std::string& port, const std::string& default_channel, std::function<void(const Msg&)> handler,
+                 InputKind kind = InputKind::Stream);
   // Declare an output port.
   void advertise(const std::string& port, const std::string& default_channel);
   // Encode and publish on a port; fills header.seq with the port's sequence number.
@@ -82,6 +90,7 @@ class Node {
   struct Input {
     std::string port;
     std::function<void(const std::uint8_t*, std::size_t)> handle;
+    InputKind kind = InputKind::Stream;
     std::int64_t last_utime = -1;
     std::int64_t last_seq = -1;
   };
@@ -102,11 +111,12 @@ class Node {
 
 template <class Msg>
 void Node::subscribe(const std::string& port, const std::string& default_channel,
-                     std::function<void(const Msg&)> handler) {
+                     std::function<void(const Msg&)> handler, InputKind kind) {
   channels_.emplace(port, default_channel);
   if (primary_port_.empty()) primary_port_ = port;
   Input input;
   input.port = port;
+  input.kind = kind;
   input.handle = [this, port, handler = std::move(handler)](const std::uint8_t* data, std::size_t size) {
     Msg msg;
     int used = -1;

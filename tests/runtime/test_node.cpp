@@ -109,6 +109,42 @@ TEST(Node, ForwardTimeJumpIsCountedAndResetsState) {
   EXPECT_EQ(sink.utimes.size(), 3u);  // the message after the gap is still processed
 }
 
+// Sparse results (loop closures, graphs) have long gaps by nature: not time jumps, but still ordered.
+class EventNode : public adit::runtime::Node {
+ public:
+  EventNode() : Node("events") {
+    subscribe<adit::imu_t>("in", "EVENTS", [this](const adit::imu_t&) { ++handled; }, adit::runtime::InputKind::Events);
+  }
+  int handled = 0;
+};
+
+TEST(Node, EventInputsHaveNoTimeJumpsButStayOrdered) {
+  EventNode node;
+  Collector sink;
+  deliver(node, imuBytes(1'000'000), sink, "EVENTS");
+  deliver(node, imuBytes(60'000'000), sink, "EVENTS");  // a minute later: normal for loop closures
+  deliver(node, imuBytes(30'000'000), sink, "EVENTS");  // backwards: still dropped
+  EXPECT_EQ(node.handled, 2);
+  EXPECT_EQ(node.health().counters.count("time_jump"), 0u);
+  EXPECT_EQ(node.health().counters.at("time_backwards"), 1);
+}
+
+TEST(Node, SequenceGapsAreCountedAsLostInput) {
+  CopyNode node;
+  Collector sink;
+  for (std::int64_t seq : {0, 1, 4, 5}) {
+    adit::ImuSample s;
+    s.utime = 1000 * (seq + 1);
+    adit::imu_t m = adit::msg::toMessage(s);
+    m.header.seq = seq;
+    Bytes b(static_cast<std::size_t>(m.getEncodedSize()));
+    m.encode(b.data(), 0, static_cast<int>(b.size()));
+    deliver(node, b, sink);
+  }
+  EXPECT_EQ(node.health().counters.at("lost_input"), 2);
+  EXPECT_EQ(sink.utimes.size(), 4u);  // a loss upstream does not stop the stage
+}
+
 TEST(Node, StageExceptionIsCountedNotPropagated) {
   CopyNode node;
   Collector sink;
