@@ -4,6 +4,7 @@
 #include "drivers/udp_receiver.hpp"
 #include "drivers/vlp16_decoder.hpp"
 #include "msg/convert.hpp"
+#include "msg/encode.hpp"
 #include "runtime/process.hpp"
 
 #include <spdlog/spdlog.h>
@@ -63,8 +64,7 @@ class UdpLidarSource : public runtime::MessageSource {
     LidarScan& scan = ready_.front();
     adit::point_cloud_t m = msg::toMessage(scan);
     out.channel = channel_;
-    out.data.resize(static_cast<std::size_t>(m.getEncodedSize()));
-    m.encode(out.data.data(), 0, static_cast<int>(out.data.size()));
+    out.data = msg::encode(m);
     out.utime = scan.utime;
     ready_.pop_front();
     return true;

@@ -2,6 +2,7 @@
 
 #include "features/feature_extractor.hpp"
 #include "msg/convert.hpp"
+#include "nodes/imu_buffer.hpp"
 
 #include <deque>
 
@@ -10,13 +11,15 @@ namespace {
 
 class FeatureNode : public runtime::Node {
  public:
-  explicit FeatureNode(const Config& config) : Node("feature"), extractor_(featureConfigFrom(config)) {
-    // IMU older than a sweep plus this margin is of no further use to deskewing.
-    imu_keep_s_ = config.get<double>("features.node.imu_keep_s", 0.5);
+  explicit FeatureNode(const Config& config)
+      : Node("feature"),
+        extractor_(featureConfigFrom(config)),
+        // IMU older than a sweep plus this margin is of no further use to deskewing.
+        imu_(config.get<double>("features.node.imu_keep_s", 0.5)) {
     // An odometry pose older than this (s) before a sweep is too stale to predict its motion.
     max_prior_age_s_ = config.get<double>("features.node.max_prior_age_s", 0.3);
     subscribe<adit::point_cloud_t>("points", "LIDAR_POINTS", [this](const adit::point_cloud_t& m) { onSweep(m); });
-    subscribe<adit::imu_t>("imu", "IMU", [this](const adit::imu_t& m) { onImu(m); });
+    subscribe<adit::imu_t>("imu", "IMU", [this](const adit::imu_t& m) { imu_.add(m); });
     subscribe<adit::odometry_t>("odometry", "ODOM_SCAN", [this](const adit::odometry_t& m) { onOdometry(m); });
     advertise("features", "FEATURES");
   }
@@ -28,12 +31,6 @@ class FeatureNode : public runtime::Node {
   }
 
  private:
-  void onImu(const adit::imu_t& m) {
-    imu_.push_back(msg::fromMessage(m));
-    while (!imu_.empty() && imu_.front().utime < m.header.utime - static_cast<std::int64_t>(imu_keep_s_ * 1e6))
-      imu_.pop_front();
-  }
-
   void onOdometry(const adit::odometry_t& m) {
     poses_.push_back({m.header.utime, msg::fromMessage(m).pose});
     if (poses_.size() > 2) poses_.pop_front();
@@ -55,7 +52,7 @@ class FeatureNode : public runtime::Node {
   void onSweep(const adit::point_cloud_t& m) {
     const LidarScan scan = msg::fromMessage(m);
     if (scan.points.empty()) reportDrop("empty_scan", "sweep at utime " + std::to_string(scan.utime) + " has no points");
-    const std::vector<ImuSample> imu(imu_.begin(), imu_.end());
+    const std::vector<ImuSample> imu = imu_.samples();
     const FeatureSet features = extractor_.process(scan, imu, motionPrior(scan.utime));
     count("points_in", features.points_in);
     count("removed_invalid", features.removed_invalid);
@@ -68,8 +65,8 @@ class FeatureNode : public runtime::Node {
   }
 
   FeatureExtractor extractor_;
-  double imu_keep_s_ = 0.5, max_prior_age_s_ = 0.3;
-  std::deque<ImuSample> imu_;
+  ImuBuffer imu_;
+  double max_prior_age_s_ = 0.3;
   std::deque<StampedPose> poses_;
 };
 

@@ -2,6 +2,7 @@
 
 #include "features/preprocess.hpp"
 #include "msg/convert.hpp"
+#include "nodes/imu_buffer.hpp"
 #include "odometry/initial_guess.hpp"
 #include "odometry/scan_to_scan.hpp"
 
@@ -14,13 +15,15 @@ namespace {
 class OdometryNode : public runtime::Node {
  public:
   explicit OdometryNode(const Config& config)
-      : Node("odometry"), odometry_(scanToScanConfigFrom(config)), guess_config_(initialGuessConfigFrom(config)) {
-    imu_keep_s_ = config.get<double>("odometry.node.imu_keep_s", 1.0);
+      : Node("odometry"),
+        odometry_(scanToScanConfigFrom(config)),
+        guess_config_(initialGuessConfigFrom(config)),
+        imu_(config.get<double>("odometry.node.imu_keep_s", 1.0)) {
     // The sweep forwarded on ODOM_SCAN feeds only the mapper's global map (itself at 0.1 m): thin it to
     // that resolution so the bus and the logs carry a third of the bytes. 0 = forward it whole.
     forward_voxel_ = config.get<double>("odometry.node.forward_cloud_voxel", 0.1);
     subscribe<adit::features_t>("features", "FEATURES", [this](const adit::features_t& m) { onFeatures(m); });
-    subscribe<adit::imu_t>("imu", "IMU", [this](const adit::imu_t& m) { onImu(m); });
+    subscribe<adit::imu_t>("imu", "IMU", [this](const adit::imu_t& m) { imu_.add(m); });
     advertise("odometry", "ODOM_SCAN");
   }
 
@@ -34,15 +37,9 @@ class OdometryNode : public runtime::Node {
   }
 
  private:
-  void onImu(const adit::imu_t& m) {
-    imu_.push_back(msg::fromMessage(m));
-    while (!imu_.empty() && imu_.front().utime < m.header.utime - static_cast<std::int64_t>(imu_keep_s_ * 1e6))
-      imu_.pop_front();
-  }
-
   void onFeatures(const adit::features_t& m) {
     FeatureSet features = msg::fromMessage(m);
-    const std::vector<ImuSample> imu(imu_.begin(), imu_.end());
+    const std::vector<ImuSample> imu = imu_.samples();
     const InitialGuess guess = initialGuess(previous_ ? &*previous_ : nullptr, features,
                                             odometry_.predictMotion(features.utime), imu, guess_config_);
     count("link3d_matches", guess.link3d_matches);
@@ -63,8 +60,8 @@ class OdometryNode : public runtime::Node {
 
   ScanToScanOdometry odometry_;
   InitialGuessConfig guess_config_;
-  double imu_keep_s_ = 1.0, forward_voxel_ = 0.1;
-  std::deque<ImuSample> imu_;
+  ImuBuffer imu_;
+  double forward_voxel_ = 0.1;
   std::optional<FeatureSet> previous_;
 };
 

@@ -7,6 +7,7 @@
 // backwards on a channel are counted and skipped (with one log line), never thrown.
 #pragma once
 
+#include "msg/encode.hpp"
 #include "runtime/health.hpp"
 
 #include <cstdint>
@@ -137,11 +138,9 @@ void Node::subscribe(const std::string& port, const std::string& default_channel
 }
 
 template <class Msg>
-void Node::publish(const std::string& port, Msg& msg) {
-  msg.header.seq = seq_[port]++;
-  Bytes bytes(static_cast<std::size_t>(msg.getEncodedSize()));
-  msg.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
-  emit(port, std::move(bytes), msg.header.utime);
+void Node::publish(const std::string& port, Msg& message) {
+  message.header.seq = seq_[port]++;
+  emit(port, msg::encode(message), message.header.utime);
 }
 
 }  // namespace adit::runtime

@@ -3,6 +3,7 @@
 #include "io/imu_csv.hpp"
 #include "io/kitti.hpp"
 #include "msg/convert.hpp"
+#include "msg/encode.hpp"
 
 #include <spdlog/spdlog.h>
 
@@ -10,13 +11,6 @@
 
 namespace adit::sources {
 namespace {
-
-template <class Msg>
-runtime::Bytes encode(Msg& m) {
-  runtime::Bytes bytes(static_cast<std::size_t>(m.getEncodedSize()));
-  m.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
-  return bytes;
-}
 
 // Reads sweep i of n with `read`; skips (and counts) unreadable sweeps and sweeps whose time does not advance.
 class ScanFileSource : public runtime::MessageSource {
@@ -43,7 +37,7 @@ class ScanFileSource : public runtime::MessageSource {
       last_utime_ = scan.utime;
       scan.seq = seq_++;
       adit::point_cloud_t m = msg::toMessage(scan);
-      out = {channel_, encode(m), scan.utime};
+      out = {channel_, msg::encode(m), scan.utime};
       ++health_.outputs;
       return true;
     }
@@ -86,7 +80,7 @@ class ImuSource : public runtime::MessageSource {
       last_utime_ = s.utime;
       adit::imu_t m = msg::toMessage(s);
       m.header.seq = seq_++;
-      out = {channel_, encode(m), s.utime};
+      out = {channel_, msg::encode(m), s.utime};
       ++health_.outputs;
       return true;
     }

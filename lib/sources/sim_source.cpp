@@ -1,18 +1,9 @@
 #include "sources/sim_source.hpp"
 
 #include "msg/convert.hpp"
+#include "msg/encode.hpp"
 
 namespace adit::sources {
-namespace {
-
-template <class Msg>
-runtime::Bytes encode(Msg& m) {
-  runtime::Bytes bytes(static_cast<std::size_t>(m.getEncodedSize()));
-  m.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
-  return bytes;
-}
-
-}  // namespace
 
 SimSource::SimSource(const sim::SimConfig& config, SimChannels channels)
     : simulator_(config), channels_(std::move(channels)) {}
@@ -33,7 +24,7 @@ bool SimSource::next(runtime::OutgoingMessage& out) {
   if (!simulator_.next(event)) return false;
   if (event.kind == sim::SimEvent::Kind::Scan) {
     adit::point_cloud_t m = msg::toMessage(event.scan);
-    out = {channels_.lidar, encode(m), event.scan.utime};
+    out = {channels_.lidar, msg::encode(m), event.scan.utime};
     truth_.push_back(event.truth);
     if (!channels_.ground_truth.empty()) {
       PoseEstimate truth;
@@ -42,12 +33,12 @@ bool SimSource::next(runtime::OutgoingMessage& out) {
       truth.covariance.setZero();
       adit::odometry_t t = msg::toMessage(truth, nullptr);
       t.header.seq = truth_seq_++;
-      pending_truth_ = runtime::OutgoingMessage{channels_.ground_truth, encode(t), truth.utime};
+      pending_truth_ = runtime::OutgoingMessage{channels_.ground_truth, msg::encode(t), truth.utime};
     }
   } else {
     adit::imu_t m = msg::toMessage(event.imu);
     m.header.seq = imu_seq_++;
-    out = {channels_.imu, encode(m), event.imu.utime};
+    out = {channels_.imu, msg::encode(m), event.imu.utime};
   }
   ++health_.outputs;
   return true;

@@ -120,3 +120,47 @@ TEST_F(Cli, StageThatIsNotWrittenSaysSoAndExitsNonZero) {
     }
   }
 }
+
+TEST_F(Cli, SimWritesTheSameLogForTheSameSeed) {
+  for (const char* name : {"sim_a", "sim_b"})
+    ASSERT_EQ(run(bin("adit") + " sim --world roadway-straight --duration 3 --seed 7 -o " + (dir_ / name).string() +
+                      ".lcmlog --gt " + (dir_ / name).string() + ".tum",
+                  dir_ / "sim.txt"),
+              0)
+        << slurp(dir_ / "sim.txt");
+  EXPECT_EQ(slurp(dir_ / "sim_a.lcmlog"), slurp(dir_ / "sim_b.lcmlog"));
+  const auto p = payloads((dir_ / "sim_a.lcmlog").string());
+  EXPECT_EQ(p.at("LIDAR_POINTS").size(), 30u);  // 10 Hz
+  EXPECT_EQ(p.at("GROUND_TRUTH").size(), 30u);
+  EXPECT_GE(p.at("IMU").size(), 590u);  // 200 Hz
+  EXPECT_EQ(slurp(dir_ / "sim_a.tum"), slurp(dir_ / "sim_b.tum"));
+}
+
+TEST_F(Cli, AblationRunsTheThreeVariantsAndPrintsOneTable) {
+  const fs::path log = dir_ / "ablation.lcmlog", gt = dir_ / "ablation_gt.tum";
+  ASSERT_EQ(run(bin("adit") + " sim --world roadway-straight --duration 10 --seed 2 -o " + log.string() + " --gt " +
+                    gt.string(),
+                dir_ / "ablation_sim.txt"),
+            0);
+  ASSERT_EQ(run(bin("adit") + " bench ablation " + log.string() + " --gt " + gt.string() + " -o " +
+                    (dir_ / "ablation").string(),
+                dir_ / "ablation.txt"),
+            0)
+      << slurp(dir_ / "ablation.txt");
+  const std::string out = slurp(dir_ / "ablation.txt");
+  for (const char* row : {"A-LOAM ", "+ LinK3D ", "+ LinK3D + Scan Context"})
+    EXPECT_NE(out.find(std::string("\n") + row), std::string::npos) << row << " missing in:\n" << out;
+  EXPECT_NE(out.find("rmse"), std::string::npos) << out;
+  // The variants really differ: plain A-LOAM and the LinK3D-seeded pipeline do not give the same trajectory.
+  EXPECT_NE(slurp(dir_ / "ablation" / "A-LOAM" / "trajectory.tum"), slurp(dir_ / "ablation" / "LinK3D" / "trajectory.tum"));
+}
+
+TEST_F(Cli, DemoEndsWithAReportAndPlots) {
+  const fs::path out = dir_ / "demo";
+  ASSERT_EQ(run(bin("adit") + " demo --duration 12 -o " + out.string(), dir_ / "demo.txt"), 0) << slurp(dir_ / "demo.txt");
+  const std::string report = slurp(dir_ / "demo.txt");
+  for (const char* line : {"distance travelled", "loops closed", "APE rmse", "real time", "map.pcd", "trajectory.png"})
+    EXPECT_NE(report.find(line), std::string::npos) << line << " missing in:\n" << report;
+  for (const char* file : {"map.pcd", "trajectory.tum", "odometry.tum", "ground_truth.tum", "trajectory.png", "map.png"})
+    EXPECT_TRUE(fs::exists(out / file)) << file;
+}
