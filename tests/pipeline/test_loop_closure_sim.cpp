@@ -75,12 +75,14 @@ LoopRun runSimulation(const std::string& world, double duration_s, std::uint64_t
 }  // namespace
 
 TEST(LoopClosureSim, RoadwayLoopClosesVerifiedLoopsAndHalvesTheError) {
-  // One lap of the 510 m loop takes ~405 s: 440 s revisits the start and drives on past it.
-  const LoopRun run = runSimulation("roadway-loop", 440.0, 1);
+  // One lap of the 510 m loop takes ~405 s; the world is specified to be driven 1.2 times (500 s), so the
+  // revisit of the first 100 m closes loops after a full lap of drift. (At 440 s, just past the start, the
+  // drift is smaller: 0.235 m -> 0.133 m was measured.)
+  const LoopRun run = runSimulation("roadway-loop", 500.0, 1);
   const auto before = adit::eval::evaluate(run.ground_truth, run.odometry);
   const auto after = adit::eval::evaluate(run.ground_truth, run.corrected);
   ASSERT_TRUE(before.valid && after.valid);
-  std::printf("roadway-loop 440 s: %zu loops (%d false; worst loop error %.3f m / %.2f deg), APE rmse %.3f m without "
+  std::printf("roadway-loop 500 s: %zu loops (%d false; worst loop error %.3f m / %.2f deg), APE rmse %.3f m without "
               "loop closure, %.3f m with it, over %.0f m\n",
               run.loops.size(), run.false_loops, run.worst_loop_error_m, run.worst_loop_error_deg, before.ape_m.rmse,
               after.ape_m.rmse, after.gt_distance_m);
