@@ -52,66 +52,90 @@ std::string timingJson(const ReplayReport& r) {
   return out;
 }
 
-}  // namespace
-
-ReplayReport runReplay(const ReplayOptions& options) {
-  const auto wall_start = std::chrono::steady_clock::now();
-  ReplayReport report;
-  fs::create_directories(options.out_dir);
-
-  // Build every requested stage that exists, in pipeline order.
+// Every requested stage that is written, in pipeline order; the others are listed as missing.
+std::vector<std::unique_ptr<runtime::Node>> buildNodes(const ReplayOptions& options, ReplayReport& report) {
   std::vector<std::unique_ptr<runtime::Node>> nodes;
   for (const auto& name : nodes::pipelineNodeNames()) {
     if (!options.stages.empty() && std::find(options.stages.begin(), options.stages.end(), name) == options.stages.end())
       continue;
     try {
       nodes.push_back(nodes::makeNode(name, options.config));
-      nodes.back()->timing().setCapacity(0);
+      nodes.back()->timing().setCapacity(0);  // keep every sample for timing.json
       report.stages_run.push_back(name);
     } catch (const runtime::StageNotImplemented&) {
       report.stages_missing.push_back(name);
     }
   }
+  return nodes;
+}
 
-  std::unique_ptr<runtime::LogReader> log;
-  if (!options.source) log = std::make_unique<runtime::LogReader>(options.input_log);
+// The input of a replay: a log file or a message source, one event at a time.
+class Input {
+ public:
+  explicit Input(const ReplayOptions& options) : source_(options.source) {
+    if (!source_) log_ = std::make_unique<runtime::LogReader>(options.input_log);
+  }
+  bool next(runtime::LogEvent& event) {
+    if (log_) return log_->next(event);
+    runtime::OutgoingMessage message;
+    if (!source_->next(message)) return false;
+    event.channel = std::move(message.channel);
+    event.data = std::move(message.data);
+    event.timestamp = message.utime;
+    return true;
+  }
+  double progress() const { return log_ ? log_->progress() : source_->progress(); }
+  std::int64_t corruptFrames() const { return log_ ? log_->corruptFrames() : 0; }
+  bool truncated() const { return log_ && log_->truncated(); }
+
+ private:
+  runtime::MessageSource* source_;
+  std::unique_ptr<runtime::LogReader> log_;
+};
+
+// Products in pipeline order: a later stage's file replaces an earlier one's (see nodes/products.hpp).
+void writeProducts(const std::vector<std::unique_ptr<runtime::Node>>& nodes, const std::string& out_dir,
+                   std::vector<std::string>& products) {
+  for (const auto& node : nodes) {
+    auto* writer = dynamic_cast<nodes::WritesProducts*>(node.get());
+    if (!writer || node->health().inputs == 0) continue;
+    for (const auto& path : writer->writeProducts(out_dir))
+      if (std::find(products.begin(), products.end(), path) == products.end()) products.push_back(path);
+  }
+}
+
+}  // namespace
+
+ReplayReport runReplay(const ReplayOptions& options) {
+  const auto wall_start = std::chrono::steady_clock::now();
+  ReplayReport report;
+  fs::create_directories(options.out_dir);
+  const auto nodes = buildNodes(options, report);
+  Input input(options);
   runtime::LogWriter output((fs::path(options.out_dir) / "output.lcmlog").string());
-  // The bus logs nothing itself: this observer writes the recorded channels.
   runtime::LockstepBus bus;
   const std::regex record(options.record);
   bus.observe([&](const std::string& channel, const runtime::Bytes& data, std::int64_t utime) {
     if (std::regex_match(channel, record)) output.write(channel, data, utime);
   });
-  for (auto& node : nodes) bus.add(*node);
+  for (const auto& node : nodes) bus.add(*node);
 
   runtime::LogEvent event;
-  runtime::OutgoingMessage message;
-  const auto next = [&]() {
-    if (log) return log->next(event);
-    if (!options.source->next(message)) return false;
-    event.channel = std::move(message.channel);
-    event.data = std::move(message.data);
-    event.timestamp = message.utime;
-    return true;
-  };
   std::int64_t first_utime = -1, last_utime = -1;
-  while (!runtime::stopRequested() && next()) {
+  while (!runtime::stopRequested() && input.next(event)) {
     ++report.input_events;
     if (msg::messageTypeName(event.data.data(), event.data.size()) == "point_cloud_t") ++report.sweeps;
     if (first_utime < 0) first_utime = event.timestamp;
     last_utime = std::max(last_utime, event.timestamp);
     bus.inject(event.channel, event.data, event.timestamp);
-    if (options.on_progress && report.input_events % 64 == 0) {
-      const double fraction = log ? log->progress() : options.source->progress();
-      if (fraction >= 0) options.on_progress(fraction);
-    }
+    if (options.on_progress && report.input_events % 64 == 0 && input.progress() >= 0) options.on_progress(input.progress());
   }
   bus.finish();
   output.close();
   if (options.on_progress) options.on_progress(1.0);
 
-  report.corrupt_frames = log ? log->corruptFrames() : 0;
-  report.truncated = log && log->truncated();
+  report.corrupt_frames = input.corruptFrames();
+  report.truncated = input.truncated();
   report.output_events = output.events();
   report.products.push_back(output.path());
   for (const auto& node : nodes) {
@@ -122,14 +146,7 @@ ReplayReport runReplay(const ReplayOptions& options) {
   report.sensor_seconds = first_utime >= 0 ? static_cast<double>(last_utime - first_utime) * 1e-6 : 0.0;
   report.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
   report.peak_memory_mb = peakMemoryMb();
-  // Products in pipeline order: a later stage's file replaces an earlier one's (see nodes/products.hpp).
-  for (const auto& node : nodes) {
-    auto* writer = dynamic_cast<nodes::WritesProducts*>(node.get());
-    if (writer && node->health().inputs > 0)
-      for (const auto& path : writer->writeProducts(options.out_dir))
-        if (std::find(report.products.begin(), report.products.end(), path) == report.products.end())
-          report.products.push_back(path);
-  }
+  writeProducts(nodes, options.out_dir, report.products);
   const fs::path timing_path = fs::path(options.out_dir) / "timing.json";
   io::writeFileAtomically(timing_path.string(), timingJson(report));
   report.products.push_back(timing_path.string());

@@ -3,7 +3,6 @@
 namespace adit::runtime {
 
 void LockstepBus::publish(const std::string& channel, const Bytes& data, std::int64_t utime) {
-  if (out_) out_->write(channel, data, utime);
   for (auto& observer : observers_) observer(channel, data, utime);
   queue_.push_back({channel, data, utime});
 }

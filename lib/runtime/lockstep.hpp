@@ -3,7 +3,6 @@
 // nodes are visited in the order they were added, so a run depends only on its input: deterministic replay.
 #pragma once
 
-#include "runtime/lcm_log.hpp"
 #include "runtime/node.hpp"
 
 #include <deque>
@@ -15,11 +14,8 @@ class LockstepBus : public Sink {
  public:
   using Observer = std::function<void(const std::string& channel, const Bytes& data, std::int64_t utime)>;
 
-  // Every published message is also written to `out` when given.
-  explicit LockstepBus(LogWriter* out = nullptr) : out_(out) {}
-
   void add(Node& node) { nodes_.push_back(&node); }
-  // Called for every published message, after it is logged (e.g. to collect trajectories).
+  // Called for every published message (to log it, to collect results).
   void observe(Observer observer) { observers_.push_back(std::move(observer)); }
 
   // An input from outside (a log event): deliver it and everything it causes.
@@ -37,7 +33,6 @@ class LockstepBus : public Sink {
   };
   void drain();
 
-  LogWriter* out_;
   std::vector<Node*> nodes_;
   std::vector<Observer> observers_;
   std::deque<Pending> queue_;
