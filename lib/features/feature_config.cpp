@@ -56,6 +56,8 @@ LoamConfig loamFrom(const Config& c) {
   d.edge_threshold = c.get(k + "edge_threshold", d.edge_threshold);
   d.surf_threshold = c.get(k + "surf_threshold", d.surf_threshold);
   d.edge_min_offset = c.get(k + "edge_min_offset", d.edge_min_offset);
+  d.edge_noise_factor = c.get(k + "edge_noise_factor", d.edge_noise_factor);
+  d.noise_max_step = c.get(k + "noise_max_step", d.noise_max_step);
   d.surf_max_offset = c.get(k + "surf_max_offset", d.surf_max_offset);
   d.max_sharp = c.get(k + "max_sharp", d.max_sharp);
   d.max_less_sharp = c.get(k + "max_less_sharp", d.max_less_sharp);

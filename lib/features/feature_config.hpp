@@ -88,6 +88,15 @@ struct LoamConfig {
   // threshold, most sharp picks in a noisy box room were noise). A 90 deg corner sits ~2 beam spacings
   // off, so on a VLP-16 corners count from ~7 m; nearer, the noise hides them anyway.
   float edge_min_offset = 0.05f;
+  // features.loam.edge_noise_factor: the offset must also exceed this many times the sweep's measured range
+  // noise (PointScores::noise), so the floor follows the sensor actually used. A noise-only offset is
+  // ~1.05 sigma: at 5 sigma a 30k-point sweep has well under one false edge, at 2.5 sigma (0.05 m with the
+  // 2 cm simulated VLP-16) ~180 per sweep appeared on the smooth walls beside the sensor, slid with it and
+  // held scan matching at zero motion along a featureless roadway. 0 disables.
+  float edge_noise_factor = 5.0f;
+  // features.loam.noise_max_step (m): the noise is measured on triplets of consecutive ring points whose two
+  // steps are both shorter than this (dense enough that the surface's bend is below the noise).
+  float noise_max_step = 0.1f;
   // features.loam.surf_max_offset (m): a point this close to its neighbours' centroid is flat whatever its
   // ratio: near the sensor the beam spacing is below the noise and the ratio only measures noise.
   float surf_max_offset = 0.01f;

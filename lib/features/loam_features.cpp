@@ -57,7 +57,8 @@ struct RingSelection {
   }
 
   bool isEdge(int i) const {
-    return s.usable[i] && s.smoothness[i] > cfg.edge_threshold && s.offset[i] > cfg.edge_min_offset;
+    return s.usable[i] && s.smoothness[i] > cfg.edge_threshold &&
+           s.offset[i] > std::max(cfg.edge_min_offset, cfg.edge_noise_factor * s.noise);
   }
   bool isFlat(int i) const {
     return s.usable[i] && !isEdge(i) && (s.smoothness[i] < cfg.surf_threshold || s.offset[i] < cfg.surf_max_offset);

@@ -46,6 +46,24 @@ void scoreRing(const RingCloud& c, int b, int e, const LoamConfig& cfg, PointSco
   }
 }
 
+// Second-difference lengths of points [b, e) of one ring whose two steps are both shorter than max_step
+// (see PointScores::noise).
+void collectSecondDifferences(const RingCloud& c, int b, int e, float max_step, std::vector<float>& out) {
+  const float max_sq = max_step * max_step;
+  for (int j = b + 1; j + 1 < e; ++j) {
+    const Eigen::Vector3f &p = c.points[j - 1].p, &q = c.points[j].p, &r = c.points[j + 1].p;
+    if ((q - p).squaredNorm() > max_sq || (r - q).squaredNorm() > max_sq) continue;
+    out.push_back((p - 2.0f * q + r).norm());
+  }
+}
+
+float medianNoise(std::vector<float>& second) {
+  if (second.size() < 100) return 0.0f;
+  const auto mid = second.begin() + static_cast<long>(second.size() / 2);
+  std::nth_element(second.begin(), mid, second.end());
+  return *mid / 1.652f;  // median of |N(0, 6 sigma^2)| = 0.6745 sqrt(6) sigma
+}
+
 // Marks the far side of depth jumps and beam-parallel points as unusable.
 void markUnreliable(int b, int e, const LoamConfig& cfg, PointScores& s) {
   const int w = cfg.half_window;
@@ -72,14 +90,18 @@ PointScores scorePoints(const RingCloud& c, const LoamConfig& cfg) {
   s.smoothness.assign(n, -1.0f);
   s.offset.assign(n, 0.0f);
   s.usable.assign(n, 1);
+  std::vector<float> second;
+  second.reserve(n);
   for (std::size_t i = 0; i < n; ++i) s.range[i] = c.points[i].p.norm();
   for (int r = 0; r < c.numRings(); ++r) {
     const int b = c.ring_begin[r], e = c.ring_begin[r + 1];
     scoreRing(c, b, e, cfg, s);
+    collectSecondDifferences(c, b, e, cfg.noise_max_step, second);
     markUnreliable(b, e, cfg, s);
     for (int i = b; i < e; ++i)
       if (s.smoothness[i] < 0.0f) s.usable[i] = 0;
   }
+  s.noise = medianNoise(second);
   return s;
 }
 
