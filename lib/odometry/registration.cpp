@@ -5,6 +5,7 @@
 
 #include <ceres/ceres.h>
 
+#include <algorithm>
 #include <memory>
 
 namespace adit {
@@ -72,6 +73,22 @@ void addDirectionalPriors(ceres::Problem& problem, double* xi, const DegeneracyR
   }
 }
 
+// Zhang 2016's solution remapping: the solution's component along each degenerate eigen-direction is
+// replaced by the prior's. Measurements there are too weak to trust, and a soft prior still leaks toward
+// whatever they say; the motion model is the previous estimate, so a leak of a few percent per sweep
+// compounds into an exponential decay of the velocity along a featureless roadway.
+void remapDegenerate(Vector6d& xi, const DegeneracyReport& d, const Vector6d& target) {
+  for (int block = 0; block < 2; ++block) {
+    const auto& degenerate = block == 0 ? d.translation_degenerate : d.rotation_degenerate;
+    const Eigen::Matrix3d& dirs = block == 0 ? d.translation_directions : d.rotation_directions;
+    for (int i = 0; i < 3; ++i) {
+      if (!degenerate[i]) continue;
+      const Eigen::Vector3d v = dirs.col(i);
+      xi.segment<3>(3 * block) += v * v.dot(target.segment<3>(3 * block) - xi.segment<3>(3 * block));
+    }
+  }
+}
+
 }  // namespace
 
 RegistrationConfig registrationConfigFrom(const Config& c, const std::string& prefix,
@@ -88,6 +105,7 @@ RegistrationConfig registrationConfigFrom(const Config& c, const std::string& pr
   r.degeneracy_prior = c.get<bool>(key("degeneracy_prior"), r.degeneracy_prior);
   r.degeneracy_from_planes_only = c.get<bool>(key("degeneracy_from_planes_only"), r.degeneracy_from_planes_only);
   r.degeneracy_prior_strength = c.get<double>(key("degeneracy_prior_strength"), r.degeneracy_prior_strength);
+  r.degeneracy_remap = c.get<bool>(key("degeneracy_remap"), r.degeneracy_remap);
   r.prior_sigma_translation_m = c.get<double>(key("prior_sigma_translation_m"), r.prior_sigma_translation_m);
   r.prior_sigma_rotation_rad = c.get<double>(key("prior_sigma_rotation_rad"), r.prior_sigma_rotation_rad);
   return r;
@@ -112,8 +130,9 @@ RegistrationResult registerStep(const Correspondences& matches, const Eigen::Iso
   // Degeneracy at the linearisation point decides where the motion prior applies during this round.
   const Matrix6d H0 = informationOf(problem, degeneracy_ids, config.point_sigma_m);
   const DegeneracyReport d0 = analyzeDegeneracy(H0, config.degeneracy_ratio_translation, config.degeneracy_ratio_rotation);
-  if (config.degeneracy_prior && d0.flags != 0 && isFinitePose(motion_prior))
-    addDirectionalPriors(problem, xi, d0, incrementBetween(T0, motion_prior), config);
+  const bool hold = config.degeneracy_prior && d0.flags != 0 && isFinitePose(motion_prior);
+  const Vector6d target = hold ? incrementBetween(T0, motion_prior) : Vector6d::Zero();
+  if (hold) addDirectionalPriors(problem, xi, d0, target, config);
 
   ceres::Solver::Options options;
   options.linear_solver_type = ceres::DENSE_QR;
@@ -124,8 +143,12 @@ RegistrationResult registerStep(const Correspondences& matches, const Eigen::Iso
   ceres::Solver::Summary summary;
   ceres::Solve(options, &problem, &summary);
 
-  const Vector6d solution = Eigen::Map<const Vector6d>(xi);
+  Vector6d solution = Eigen::Map<const Vector6d>(xi);
   if (!solution.allFinite()) return result;
+  if (hold && config.degeneracy_remap) {
+    remapDegenerate(solution, d0, target);
+    std::copy(solution.data(), solution.data() + 6, xi);  // the information below is evaluated there
+  }
   // Report information and degeneracy at the solution, from the measurements only.
   result.information = informationOf(problem, ids, config.point_sigma_m);
   const Matrix6d H = config.degeneracy_from_planes_only ? informationOf(problem, plane_ids, config.point_sigma_m)

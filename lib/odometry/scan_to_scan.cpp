@@ -5,6 +5,7 @@
 #include "odometry/pose_increment.hpp"
 
 #include <algorithm>
+#include <cmath>
 
 namespace adit {
 namespace {
@@ -51,6 +52,8 @@ ScanToScanConfig scanToScanConfigFrom(const Config& c) {
   s.compensate_mixed_deskew = c.get<bool>("odometry.compensate_mixed_deskew", s.compensate_mixed_deskew);
   s.use_link3d_seed = c.get<bool>("odometry.use_link3d_seed", s.use_link3d_seed);
   s.max_velocity_gap_s = c.get<double>("odometry.max_velocity_gap_s", s.max_velocity_gap_s);
+  s.hold_velocity_time_constant_s =
+      c.get<double>("odometry.hold_velocity_time_constant_s", s.hold_velocity_time_constant_s);
   return s;
 }
 
@@ -67,6 +70,21 @@ Eigen::Isometry3d ScanToScanOdometry::predictMotion(std::int64_t utime) const {
   const std::int64_t gap = utime - previous_utime_;
   if (!hasVelocity(utime)) return Eigen::Isometry3d::Identity();
   return scaleMotion(last_motion_, static_cast<double>(gap) / static_cast<double>(last_gap_us_));
+}
+
+Eigen::Isometry3d ScanToScanOdometry::predictHeldMotion(std::int64_t utime) const {
+  if (!hasVelocity(utime)) return Eigen::Isometry3d::Identity();
+  return applyIncrement(Eigen::Isometry3d::Identity(), held_velocity_ * toSeconds(utime - previous_utime_));
+}
+
+void ScanToScanOdometry::updateHeldVelocity(const Eigen::Isometry3d& T_prev_curr, std::int64_t gap_us) {
+  const double gap_s = toSeconds(gap_us);
+  if (!(gap_s > 0.0)) return;
+  const Vector6d velocity = incrementBetween(Eigen::Isometry3d::Identity(), T_prev_curr) / gap_s;
+  const double tau = config_.hold_velocity_time_constant_s;
+  // The first velocity (none known before) is taken as it is; then an exponential average.
+  const double alpha = (last_gap_us_ == 0 || !(tau > 0.0)) ? 1.0 : 1.0 - std::exp(-gap_s / tau);
+  held_velocity_ += alpha * (velocity - held_velocity_);
 }
 
 std::optional<LineFit> ScanToScanOdometry::fitLocalLine(const Eigen::Vector3d& q, double max_sq) const {
@@ -195,7 +213,7 @@ PoseEstimate ScanToScanOdometry::process(const FeatureSet& f, const std::optiona
   // Along degenerate directions hold to the motion model (IMU-aided if the prior came from the IMU), never
   // to a LinK3D seed: that one is measured from the same, degenerate, geometry.
   const bool imu_prior = prior_usable && (prior_flags & PoseEstimate::kSeededByImu) != 0;
-  const Eigen::Isometry3d hold = imu_prior ? *prior : motion_model;
+  const Eigen::Isometry3d hold = imu_prior ? *prior : predictHeldMotion(f.utime);
   // Before a velocity is known the motion model says nothing (its identity is not "standing still"):
   // holding a degenerate direction to it would pin the estimate at zero motion.
   const bool can_hold = imu_prior || hasVelocity(f.utime);
@@ -232,6 +250,7 @@ PoseEstimate ScanToScanOdometry::process(const FeatureSet& f, const std::optiona
   }
 
   if (has_previous_) {
+    updateHeldVelocity(T, f.utime - previous_utime_);
     last_motion_ = T;
     last_gap_us_ = f.utime - previous_utime_;
     pose_ = pose_ * T;

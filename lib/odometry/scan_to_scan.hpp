@@ -7,6 +7,7 @@
 #include "core/config.hpp"
 #include "core/types.hpp"
 #include "odometry/feature_fit.hpp"
+#include "odometry/pose_increment.hpp"
 #include "odometry/registration.hpp"
 #include "odometry/ring_cloud.hpp"
 
@@ -50,6 +51,12 @@ struct ScanToScanConfig {
   bool compensate_mixed_deskew = true;
   // Longest gap between sweeps (s) over which the constant-velocity model extrapolates; beyond, no motion.
   double max_velocity_gap_s = 0.5;
+  // Time constant (s) of the velocity that degenerate directions are held to: an exponential average of the
+  // estimated motions rather than the last one. Where the roadway axis is barely observed (just before it is
+  // flagged degenerate) a single sweep's axial motion errs by ~3 cm (20% at 1.3 m/s), and the prior then
+  // carries whatever the last sweep said along the whole degenerate stretch. A robot's speed changes slowly
+  // (0.3 m/s^2 is 3 cm/s a sweep), so averaging over ~1 s costs little lag. 0 = the last motion.
+  double hold_velocity_time_constant_s = 1.0;
 };
 
 // Plain A-LOAM laserOdometry behaviour, for the "before vs after" ablation: motion-model seed only (LinK3D
@@ -75,6 +82,9 @@ class ScanToScanOdometry {
 
   // Constant-velocity guess of T_prev_curr for a sweep at `utime` (identity before two sweeps were seen).
   Eigen::Isometry3d predictMotion(std::int64_t utime) const;
+  // Constant-velocity guess from the averaged velocity (hold_velocity_time_constant_s): what degenerate
+  // directions are held to.
+  Eigen::Isometry3d predictHeldMotion(std::int64_t utime) const;
   // True when predictMotion(utime) is an extrapolated velocity rather than the identity of ignorance.
   bool hasVelocity(std::int64_t utime) const;
 
@@ -114,6 +124,8 @@ class ScanToScanOdometry {
   Eigen::Isometry3d pose_ = Eigen::Isometry3d::Identity();        // T_odom_lidar of the previous sweep
   Eigen::Isometry3d last_motion_ = Eigen::Isometry3d::Identity();  // T_prev_curr of the previous step
   std::int64_t last_gap_us_ = 0;                                   // 0: no velocity estimate yet
+  Vector6d held_velocity_ = Vector6d::Zero();  // averaged tangent velocity (per second), see predictHeldMotion
+  void updateHeldVelocity(const Eigen::Isometry3d& T_prev_curr, std::int64_t gap_us);
 };
 
 }  // namespace adit

@@ -20,7 +20,8 @@ TEST(OdometryConfig, DefaultsWhenKeysAreMissing) {
 TEST(OdometryConfig, KeysAreRead) {
   const Config c = Config::fromYamlString(
       "odometry:\n  outer_iterations: 5\n  max_match_distance_m: 2.5\n  loss: cauchy\n"
-      "  degeneracy_ratio_translation: 0.05\n  use_link3d_seed: false\n"
+      "  degeneracy_ratio_translation: 0.05\n  use_link3d_seed: false\n  degeneracy_remap: false\n"
+      "  hold_velocity_time_constant_s: 2.5\n"
       "mapping:\n  local_map_radius_m: 40\n  surf_resolution_m: 0.8\n  degeneracy_prior: false\n");
   const ScanToScanConfig s = scanToScanConfigFrom(c);
   EXPECT_EQ(s.outer_iterations, 5);
@@ -28,6 +29,8 @@ TEST(OdometryConfig, KeysAreRead) {
   EXPECT_EQ(s.registration.loss, "cauchy");
   EXPECT_DOUBLE_EQ(s.registration.degeneracy_ratio_translation, 0.05);
   EXPECT_FALSE(s.use_link3d_seed);
+  EXPECT_FALSE(s.registration.degeneracy_remap);
+  EXPECT_DOUBLE_EQ(s.hold_velocity_time_constant_s, 2.5);
   const MapperConfig m = mapperConfigFrom(c);
   EXPECT_DOUBLE_EQ(m.local_map_radius_m, 40.0);
   EXPECT_DOUBLE_EQ(m.surf_resolution_m, 0.8);
