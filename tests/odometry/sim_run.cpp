@@ -1,6 +1,5 @@
 #include "sim_run.hpp"
 
-#include "features/feature_config.hpp"
 #include "features/feature_extractor.hpp"
 #include "sim/simulator.hpp"
 
@@ -8,20 +7,29 @@
 
 namespace adit::test {
 
-SimRun simulateRun(const std::string& world, const std::string& sensor, double seconds, std::uint64_t seed) {
-  sim::SimConfig config;
-  config.world = world;
-  config.sensor = sensor;
-  config.duration_s = seconds;
-  config.seed = seed;
-  sim::Simulator simulator(config);
+FeatureConfig featureConfigForSensor(const std::string& sensor) {
   FeatureConfig fc;
   if (sensor == "hdl64") {
     fc.preprocess.num_rings = 64;
     fc.preprocess.min_elevation_deg = -24.9f;
     fc.preprocess.max_elevation_deg = 2.0f;
   }
-  const FeatureExtractor extractor(fc);
+  return fc;
+}
+
+SimRun simulateRun(const std::string& world, const std::string& sensor, double seconds, std::uint64_t seed) {
+  return simulateRun(world, sensor, seconds, seed, featureConfigForSensor(sensor));
+}
+
+SimRun simulateRun(const std::string& world, const std::string& sensor, double seconds, std::uint64_t seed,
+                   const FeatureConfig& features) {
+  sim::SimConfig config;
+  config.world = world;
+  config.sensor = sensor;
+  config.duration_s = seconds;
+  config.seed = seed;
+  sim::Simulator simulator(config);
+  const FeatureExtractor extractor(features);
   SimRun run;
   std::deque<ImuSample> imu;
   sim::SimEvent event;
