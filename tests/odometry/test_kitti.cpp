@@ -86,8 +86,8 @@ double worst(const std::vector<double>& v) { return v.empty() ? 0.0 : *std::max_
 class KittiOdometry : public ::testing::TestWithParam<const char*> {};
 
 // 01 (highway, few features) and 02 (rural) have reliable ground truth: 0.1 m and 0.3 deg per pair.
-// Measured: 01 worst 0.021 m / 0.21 deg (odometry), 0.036 m / 0.17 deg (mapping); 02 worst 0.052 m / 0.16 deg
-// and 0.061 m / 0.12 deg.
+// Measured: 01 worst 0.021 m / 0.22 deg (odometry), 0.040 m / 0.18 deg (mapping); 02 worst 0.057 m / 0.16 deg
+// and 0.050 m / 0.11 deg (before the edge noise floor: 0.021 / 0.21, 0.036 / 0.17; 0.052 / 0.16, 0.061 / 0.12).
 TEST_P(KittiOdometry, RelativePoseErrorPerPairIsSmall) {
   const PairErrors e = runSequence(GetParam(), false);
   std::printf("%s worst: odometry %.3f m %.3f deg, mapping %.3f m %.3f deg; LinK3D-seeded %d/9\n", GetParam(),
