@@ -52,7 +52,7 @@ TEST(ConfigFiles, SensorAndVariantFilesNameOnlyRealKeys) {
   const auto pipeline_keys = adit::nodes::pipelineConfigKeys(adit::Config{});
   const auto driver = driverKeys(adit::Config{});
   int files = 0;
-  for (const fs::path dir : {kLaunch / "sensors", kLaunch / "config"}) {
+  for (const fs::path& dir : {kLaunch / "sensors", kLaunch / "config"}) {
     for (const auto& entry : fs::directory_iterator(dir)) {
       if (entry.path().extension() != ".yaml") continue;
       ++files;
