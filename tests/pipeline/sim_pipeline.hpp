@@ -1,0 +1,74 @@
+// Runs the whole pipeline (the nodes of `adit replay`, in lockstep) on the simulator and collects what the
+// tests judge: ground truth, trajectories before and after loop closure, and the loops with their true error.
+#pragma once
+
+#include "core/geometry.hpp"
+#include "eval/trajectory_io.hpp"
+#include "msg/convert.hpp"
+#include "pipeline/replay.hpp"
+#include "runtime/lcm_log.hpp"
+#include "runtime/process.hpp"
+#include "sources/sim_source.hpp"
+
+#include <unistd.h>
+
+#include <cmath>
+#include <filesystem>
+#include <string>
+
+namespace adit::test {
+
+struct SimPipelineRun {
+  Trajectory ground_truth, odometry, corrected;
+  std::vector<LoopConstraint> loops;
+  int false_loops = 0;
+  double worst_loop_error_m = 0, worst_loop_error_deg = 0;
+};
+
+// A loop is false when its relative pose is far from the true one: a different place, not a small misfit.
+constexpr double kFalseLoopMetres = 1.0;
+constexpr double kFalseLoopDegrees = 5.0;
+
+inline SimPipelineRun runSimPipeline(const std::string& world, double duration_s, std::uint64_t seed) {
+  namespace fs = std::filesystem;
+  const fs::path launch = fs::path(ADIT_SOURCE_DIR) / "launch";
+  const Config config = runtime::loadConfig(
+      {(launch / "config" / "pipeline.yaml").string(), (launch / "sensors" / "sim.yaml").string()});
+  sim::SimConfig sim = sim::simConfigFrom(config);
+  sim.world = world;
+  sim.duration_s = duration_s;
+  sim.seed = seed;
+  sources::SimSource source(sim, {});
+
+  pipeline::ReplayOptions options;
+  options.source = &source;
+  options.out_dir = (fs::temp_directory_path() / ("adit_pipeline_" + world + "_" + std::to_string(::getpid()))).string();
+  options.config = config;
+  options.record = "^LOOP_CLOSURE$";
+  pipeline::runReplay(options);
+
+  SimPipelineRun run;
+  run.ground_truth = source.groundTruth();
+  run.odometry = eval::readTum(options.out_dir + "/odometry.tum");
+  run.corrected = eval::readTum(options.out_dir + "/trajectory.tum");
+  runtime::LogReader log(options.out_dir + "/output.lcmlog");
+  runtime::LogEvent e;
+  while (log.next(e)) {
+    adit::loop_closure_t m;
+    if (e.channel != "LOOP_CLOSURE" || m.decode(e.data.data(), 0, static_cast<int>(e.data.size())) < 0) continue;
+    const LoopConstraint loop = msg::fromMessage(m);
+    run.loops.push_back(loop);
+    const auto& truth_of = source.simulator();
+    const Eigen::Isometry3d truth =
+        truth_of.groundTruth(loop.match_utime).pose.inverse() * truth_of.groundTruth(loop.query_utime).pose;
+    const Eigen::Isometry3d error = truth.inverse() * loop.T_match_query;
+    const double metres = translationNorm(error), degrees = rotationAngle(error) * 180.0 / M_PI;
+    run.worst_loop_error_m = std::max(run.worst_loop_error_m, metres);
+    run.worst_loop_error_deg = std::max(run.worst_loop_error_deg, degrees);
+    if (metres > kFalseLoopMetres || degrees > kFalseLoopDegrees) ++run.false_loops;
+  }
+  fs::remove_all(options.out_dir);
+  return run;
+}
+
+}  // namespace adit::test
