@@ -107,9 +107,9 @@ INSTANTIATE_TEST_SUITE_P(Sequences, KittiOdometry, ::testing::Values("01", "02")
 // 00: its ground truth for these frames is interpolated, not measured: every pair advances 0.86 m and turns
 // 0.139 deg about the same axis to 4 digits, while the car accelerates from ~0.67 to ~0.82 m per scan (data
 // README) and real pairs (01, 02) show 0.1-0.2 deg of pitch/roll jitter from pair to pair. Translation is
-// judged with the README's ~0.2 m allowance; rotation at 0.3 deg plus 0.1 deg for the missing jitter, and
-// its mean at 0.25 deg. Measured: worst 0.19 m / 0.32 deg (odometry), 0.18 m / 0.30 deg (mapping), mean
-// rotation 0.22 deg.
+// judged with the README's ~0.2 m allowance. Rotation: the mapper's poses (the pipeline's output) are held to
+// the 0.3 deg; the intermediate scan-to-scan odometry gets 0.1 deg more for the missing jitter; means
+// at 0.25 deg. Measured: worst 0.18 m / 0.32 deg (odometry), 0.18 m / 0.295 deg (mapping), mean 0.22 deg.
 TEST(KittiOdometry, Sequence00) {
   const PairErrors e = runSequence("00", false);
   std::printf("00 worst: odometry %.3f m %.3f deg, mapping %.3f m %.3f deg; LinK3D-seeded %d/9\n", worst(e.odom_t),
@@ -119,7 +119,7 @@ TEST(KittiOdometry, Sequence00) {
   double mean_odom_r = 0, mean_map_r = 0;
   for (std::size_t i = 0; i < e.odom_t.size(); ++i) {
     EXPECT_LT(e.odom_r[i], 0.4) << "pair " << i;
-    EXPECT_LT(e.map_r[i], 0.4) << "pair " << i;
+    EXPECT_LT(e.map_r[i], 0.3) << "pair " << i;
     EXPECT_LT(e.odom_t[i], 0.2) << "pair " << i;
     EXPECT_LT(e.map_t[i], 0.2) << "pair " << i;
     mean_odom_r += e.odom_r[i] / 9.0;
