@@ -121,11 +121,10 @@ std::string describe(int status) {
 
 bool wantsRestart(const Child& c, int status) {
   const bool clean = WIFEXITED(status) && WEXITSTATUS(status) == 0;
-  const bool not_implemented = WIFEXITED(status) && WEXITSTATUS(status) == kExitNotImplemented;
   switch (c.spec.restart) {
     case Restart::Never: return false;
-    case Restart::OnFailure: return !clean && !not_implemented;
-    case Restart::Always: return !not_implemented;
+    case Restart::OnFailure: return !clean;
+    case Restart::Always: return true;
   }
   return false;
 }
@@ -212,9 +211,7 @@ int supervise(const LaunchSpec& spec, const SupervisorOptions& options) {
         c.next_start = Clock::now() + seconds(c.backoff_s);
         c.backoff_s = std::min(30.0, c.backoff_s * 2.0);
       } else {
-        say(c.spec.name + " " + describe(status) + (WIFEXITED(status) && WEXITSTATUS(status) == kExitNotImplemented
-                                                        ? " (stage not implemented): not restarting"
-                                                        : ": not restarting"));
+        say(c.spec.name + " " + describe(status) + ": not restarting");
         c.finished = true;
       }
     }

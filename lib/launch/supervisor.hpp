@@ -16,9 +16,6 @@ struct SupervisorOptions {
   double stop_timeout_s = 5.0;
 };
 
-// Exit code exit 3 from a stage process means "not implemented": it is not restarted.
-constexpr int kExitNotImplemented = 3;
-
 // Returns 0 when the run ended as planned, 1 if a process could not be started at all.
 int supervise(const LaunchSpec& spec, const SupervisorOptions& options);
 

@@ -40,7 +40,6 @@ struct StageTiming {
 
 struct ReplayReport {
   std::vector<std::string> stages_run;
-  std::vector<std::string> stages_missing;  // not written yet
   std::int64_t input_events = 0;
   std::int64_t output_events = 0;
   std::int64_t corrupt_frames = 0;

@@ -95,9 +95,6 @@ int runNodeProcess(int argc, char** argv, const std::string& name, const std::st
   try {
     node = factory(loadConfig(options.config_paths));
     applyRemaps(*node, options.channel_remaps);
-  } catch (const StageNotImplemented& e) {
-    spdlog::error("{}", e.what());
-    return 3;
   } catch (const std::exception& e) {
     spdlog::error("{}", e.what());
     return 2;

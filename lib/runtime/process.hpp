@@ -16,11 +16,6 @@
 
 namespace adit::runtime {
 
-// Thrown by a node factory whose stage is not written yet: the process says so and exits non-zero.
-struct StageNotImplemented : std::runtime_error {
-  using std::runtime_error::runtime_error;
-};
-
 struct ProcessOptions {
   std::string lcm_url;  // subscribe (and publish) here; "" = $LCM_DEFAULT_URL or LCM's default
   std::string out_url;  // publish here instead, if set

@@ -44,8 +44,6 @@ void registerReplayCommand(CLI::App& app) {
     if (!args->no_progress && ::isatty(STDERR_FILENO)) options.on_progress = drawProgress;
     adit::runtime::installStopHandlers();
     const auto r = adit::pipeline::runReplay(options);
-    if (!r.stages_missing.empty())
-      spdlog::warn("stages not written yet, skipped: {}", fmt::join(r.stages_missing, ", "));
     if (r.corrupt_frames || r.truncated)
       spdlog::warn("input log: {} corrupt frame(s) skipped{}", r.corrupt_frames, r.truncated ? ", truncated at the end" : "");
     fmt::print("replayed {} input messages ({:.1f} s of sensor time) in {:.2f} s with stages [{}]: {} messages out, {} "
