@@ -38,22 +38,16 @@ Eigen::Isometry3d isometryFrom3x4(const std::vector<double>& v) {
 std::vector<double> readTimes(const std::string& path) {
   std::ifstream in(path);
   if (!in) throw ReadError("KITTI: cannot open times file '" + path + "'");
-  std::vector<double> times;
-  std::string line;
-  for (int line_number = 1; std::getline(in, line); ++line_number) {
-    std::vector<double> values;
-    if (!parseNumbers(line, values) || values.size() > 1)
-      throw ReadError("KITTI: '" + path + "' line " + std::to_string(line_number) + " is not one number");
-    if (!values.empty()) times.push_back(values[0]);
-  }
-  return times;
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  return parseKittiTimes(text, path);
 }
 
-// The scan number of "000042.bin" (42), or -1 if the name is not all digits.
+// The scan number of "000042.bin" (42), or -1 if the name is not a plain number of at most 9 digits.
 long scanNumber(const fs::path& file) {
   const std::string stem = file.stem().string();
-  if (stem.empty() || !std::all_of(stem.begin(), stem.end(), [](char c) { return c >= '0' && c <= '9'; })) return -1;
-  return std::stol(stem);
+  if (stem.empty() || stem.size() > 9 || !std::all_of(stem.begin(), stem.end(), [](char c) { return c >= '0' && c <= '9'; }))
+    return -1;
+  return std::strtol(stem.c_str(), nullptr, 10);
 }
 
 }  // namespace
@@ -64,23 +58,53 @@ float kittiPointDt(float x, float y) {
   return static_cast<float>(std::clamp(dt, -kKittiSweepDuration, 0.0));
 }
 
+std::vector<double> parseKittiTimes(const std::string& text, const std::string& name) {
+  std::vector<double> times;
+  std::istringstream in(text);
+  std::string line;
+  for (int line_number = 1; std::getline(in, line); ++line_number) {
+    std::vector<double> values;
+    const auto where = [&] { return "KITTI: '" + name + "' line " + std::to_string(line_number) + ": "; };
+    if (!parseNumbers(line, values))
+      throw ReadError(where() + "'" + line.substr(0, 40) + "' is not a time in seconds");
+    if (values.size() > 1) throw ReadError(where() + std::to_string(values.size()) + " numbers, expected one time in seconds");
+    if (values.empty()) continue;
+    if (values[0] < 0.0) throw ReadError(where() + "negative time " + std::to_string(values[0]));
+    if (!times.empty() && values[0] < times.back())
+      throw ReadError(where() + "time goes backwards (" + std::to_string(values[0]) + " after " +
+                      std::to_string(times.back()) + ")");
+    times.push_back(values[0]);
+  }
+  return times;
+}
+
+std::vector<LidarPoint> parseKittiBin(const std::uint8_t* bytes, std::size_t size, const std::string& name) {
+  if (size == 0) throw ReadError("KITTI: scan '" + name + "' is empty (0 bytes)");
+  if (size % 16 != 0)
+    throw ReadError("KITTI: scan '" + name + "' is truncated or corrupt: " + std::to_string(size) +
+                    " bytes is not a multiple of 16 (4 float32 per point)");
+  std::vector<LidarPoint> points(size / 16);
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    float v[4];
+    std::memcpy(v, bytes + 16 * i, sizeof(v));
+    points[i].p = Eigen::Vector3f(v[0], v[1], v[2]);
+    points[i].intensity = v[3];
+  }
+  return points;
+}
+
 std::vector<LidarPoint> readKittiBin(const std::string& path) {
   std::error_code ec;
   const auto bytes = fs::file_size(path, ec);
   if (ec) throw ReadError("KITTI: cannot read scan '" + path + "': " + ec.message());
-  if (bytes % 16 != 0)
-    throw ReadError("KITTI: scan '" + path + "' is truncated or corrupt: " + std::to_string(bytes) +
-                    " bytes is not a multiple of 16 (4 float32 per point)");
+  if (bytes > kKittiMaxScanBytes)
+    throw ReadError("KITTI: scan '" + path + "' is " + std::to_string(bytes) + " bytes, more than any sweep (limit " +
+                    std::to_string(kKittiMaxScanBytes) + ")");
   std::ifstream in(path, std::ios::binary);
-  std::vector<float> raw(static_cast<size_t>(bytes / sizeof(float)));
+  std::vector<std::uint8_t> raw(static_cast<size_t>(bytes));
   if (!in || !in.read(reinterpret_cast<char*>(raw.data()), static_cast<std::streamsize>(bytes)))
     throw ReadError("KITTI: cannot read scan '" + path + "'");
-  std::vector<LidarPoint> points(raw.size() / 4);
-  for (size_t i = 0; i < points.size(); ++i) {
-    points[i].p = Eigen::Vector3f(raw[4 * i], raw[4 * i + 1], raw[4 * i + 2]);
-    points[i].intensity = raw[4 * i + 3];
-  }
-  return points;
+  return parseKittiBin(raw.data(), raw.size(), path);
 }
 
 KittiCalibration readKittiCalibration(const std::string& path) {

@@ -56,8 +56,18 @@ struct KittiScanReport {
 // Per-point time relative to the sweep end for a KITTI point (see the header comment), in [-0.1, 0].
 float kittiPointDt(float x, float y);
 
-// Reads a KITTI velodyne .bin file as raw points (ring 0, dt 0). Throws ReadError.
+// A .bin above this is not a sweep (an HDL-64E sweep is ~2 MB): refused before anything is allocated.
+constexpr std::uint64_t kKittiMaxScanBytes = 256ull << 20;
+
+// Reads a KITTI velodyne .bin file as raw points (ring 0, dt 0). Throws ReadError naming the file when
+// it is missing, empty, larger than kKittiMaxScanBytes or not a whole number of 16-byte points.
 std::vector<LidarPoint> readKittiBin(const std::string& path);
+// The same from bytes in memory; `name` is quoted in errors.
+std::vector<LidarPoint> parseKittiBin(const std::uint8_t* bytes, std::size_t size, const std::string& name);
+
+// times.txt: one time (s) per line, blank lines skipped. Throws ReadError naming `name`, the line and the
+// problem (not a number, several numbers, negative, going backwards).
+std::vector<double> parseKittiTimes(const std::string& text, const std::string& name);
 
 // Reads calib.txt. Throws ReadError when it is missing, or P0..P3 / Tr are missing or malformed.
 KittiCalibration readKittiCalibration(const std::string& path);

@@ -1,16 +1,13 @@
 #include "io/pcd.hpp"
 
-#include <pcl/PCLPointCloud2.h>
-#include <pcl/io/pcd_io.h>
-
 #include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <limits>
 
 #include "io/atomic_file.hpp"
+#include "io/pcd_format.hpp"
 #include "io/rings.hpp"
 
 namespace adit::io {
@@ -19,124 +16,22 @@ namespace {
 
 constexpr double kAbsoluteTimeThreshold = 1e6;  // s; per-point times above this are absolute (epoch)
 
-// One scalar field of a PCLPointCloud2, read as double whatever its stored type.
+// One scalar field, read as double whatever its stored type; absent fields read nothing.
 struct FieldReader {
   bool present = false;
-  std::uint32_t offset = 0;
-  std::uint8_t datatype = 0;
-
-  bool isInteger() const {
-    return datatype != pcl::PCLPointField::FLOAT32 && datatype != pcl::PCLPointField::FLOAT64;
-  }
-
-  template <class T>
-  static double load(const std::uint8_t* p) {
-    T v;
-    std::memcpy(&v, p, sizeof(T));
-    return static_cast<double>(v);
-  }
-
-  double read(const std::uint8_t* point) const {
-    const std::uint8_t* p = point + offset;
-    switch (datatype) {
-      case pcl::PCLPointField::INT8: return load<std::int8_t>(p);
-      case pcl::PCLPointField::UINT8: return load<std::uint8_t>(p);
-      case pcl::PCLPointField::INT16: return load<std::int16_t>(p);
-      case pcl::PCLPointField::UINT16: return load<std::uint16_t>(p);
-      case pcl::PCLPointField::INT32: return load<std::int32_t>(p);
-      case pcl::PCLPointField::UINT32: return load<std::uint32_t>(p);
-      case pcl::PCLPointField::INT64: return load<std::int64_t>(p);
-      case pcl::PCLPointField::UINT64: return load<std::uint64_t>(p);
-      case pcl::PCLPointField::FLOAT32: return load<float>(p);
-      case pcl::PCLPointField::FLOAT64: return load<double>(p);
-      default: return std::numeric_limits<double>::quiet_NaN();
-    }
-  }
+  PcdField field;
+  bool isInteger() const { return field.isInteger(); }
+  bool isFloat32() const { return field.type == 'F' && field.size == 4; }
+  double read(const std::uint8_t* point) const { return field.read(point); }
 };
 
-FieldReader findField(const pcl::PCLPointCloud2& cloud, const std::string& name) {
+FieldReader findField(const PcdCloud& cloud, const std::string& name) {
   FieldReader f;
-  for (const auto& field : cloud.fields) {
-    if (field.name != name || field.count < 1) continue;
+  if (const PcdField* field = cloud.field(name)) {
     f.present = true;
-    f.offset = field.offset;
-    f.datatype = field.datatype;
-    break;
+    f.field = *field;
   }
   return f;
-}
-
-std::uint32_t bytesOf(std::uint8_t datatype) {
-  switch (datatype) {
-    case pcl::PCLPointField::INT8:
-    case pcl::PCLPointField::UINT8: return 1;
-    case pcl::PCLPointField::INT16:
-    case pcl::PCLPointField::UINT16: return 2;
-    case pcl::PCLPointField::INT32:
-    case pcl::PCLPointField::UINT32:
-    case pcl::PCLPointField::FLOAT32: return 4;
-    case pcl::PCLPointField::INT64:
-    case pcl::PCLPointField::UINT64:
-    case pcl::PCLPointField::FLOAT64: return 8;
-    default: return 0;
-  }
-}
-
-// PCL's reader trusts the header (a garbage file can crash it), so the header and the body size are
-// checked here first. Returns an empty string if the file is safe to hand to PCL, else the problem.
-std::string checkPcdFile(const std::string& path) {
-  pcl::PCLPointCloud2 header;
-  Eigen::Vector4f origin;
-  Eigen::Quaternionf orientation;
-  int version = 0, data_type = 0;
-  unsigned int data_idx = 0;
-  pcl::PCDReader reader;
-  if (reader.readHeader(path, header, origin, orientation, version, data_type, data_idx) < 0) return "no valid PCD header";
-  if (header.fields.empty()) return "header lists no fields";
-  std::uint64_t point_bytes = 0;
-  for (const auto& f : header.fields) {
-    if (bytesOf(f.datatype) == 0 || f.count < 1) return "field '" + f.name + "' has an unknown type or count";
-    point_bytes += static_cast<std::uint64_t>(bytesOf(f.datatype)) * f.count;
-  }
-  const std::uint64_t body = point_bytes * header.width * header.height;
-  const std::uint64_t file_bytes = fs::file_size(path);
-  std::uint64_t values_per_point = 0;
-  for (const auto& f : header.fields) values_per_point += f.count;
-  // ascii: every value takes at least a digit and a separator; catches a huge WIDTH before PCL allocates.
-  if (data_type == 0 && file_bytes < data_idx + 2 * values_per_point * header.width * header.height)
-    return "truncated: too few bytes for the announced " + std::to_string(header.width * header.height) + " points";
-  if (data_type == 1 && file_bytes < data_idx + body)  // binary: raw body follows the header
-    return "truncated: " + std::to_string(file_bytes) + " bytes, header announces " + std::to_string(data_idx + body);
-  if (data_type == 2 && body > 0) {  // binary_compressed: uint32 compressed size, uint32 raw size, LZF data
-    std::ifstream in(path, std::ios::binary);
-    std::uint32_t sizes[2] = {0, 0};
-    in.seekg(data_idx);
-    if (!in.read(reinterpret_cast<char*>(sizes), sizeof(sizes))) return "truncated before the compressed body";
-    if (sizes[1] != body) return "compressed body size does not match the header";
-    if (file_bytes < data_idx + 8ull + sizes[0]) return "truncated compressed body";
-  }
-  return "";
-}
-
-pcl::PCLPointCloud2 loadCloud(const std::string& path) {
-  if (!fs::is_regular_file(path)) throw ReadError("PCD: file '" + path + "' does not exist");
-  pcl::PCLPointCloud2 cloud;
-  int status = -1;
-  try {
-    const std::string problem = checkPcdFile(path);
-    if (!problem.empty()) throw ReadError("PCD: '" + path + "' is corrupt: " + problem);
-    pcl::PCDReader reader;
-    status = reader.read(path, cloud);
-  } catch (const ReadError&) {
-    throw;
-  } catch (const std::exception& e) {
-    throw ReadError("PCD: cannot parse '" + path + "': " + e.what());
-  }
-  if (status < 0) throw ReadError("PCD: cannot parse '" + path + "' (corrupt or truncated, PCL status " + std::to_string(status) + ")");
-  const std::size_t n = static_cast<std::size_t>(cloud.width) * cloud.height;
-  if (cloud.data.size() < n * cloud.point_step)
-    throw ReadError("PCD: '" + path + "' holds fewer bytes than its header announces");
-  return cloud;
 }
 
 // Per-point times to dt (<= 0, last firing at 0). Returns the span (s) and the largest time (s).
@@ -147,7 +42,7 @@ struct TimeFill {
   double span_seconds = 0.0;
 };
 
-TimeFill fillTimes(const pcl::PCLPointCloud2& cloud, const FieldReader& time, std::vector<LidarPoint>& points) {
+TimeFill fillTimes(const PcdCloud& cloud, const FieldReader& time, std::vector<LidarPoint>& points) {
   TimeFill fill;
   const double scale = time.isInteger() ? 1e-9 : 1.0;
   std::vector<double> seconds(points.size(), std::numeric_limits<double>::quiet_NaN());
@@ -163,7 +58,7 @@ TimeFill fillTimes(const pcl::PCLPointCloud2& cloud, const FieldReader& time, st
   if (!(hi > lo)) return fill;  // no finite times, or all equal: no timing information
   fill.absolute = hi > kAbsoluteTimeThreshold;
   // float32 epoch seconds keep only ~2 min resolution: useless for per-point timing.
-  if (fill.absolute && time.datatype == pcl::PCLPointField::FLOAT32) return fill;
+  if (fill.absolute && time.isFloat32()) return fill;
   fill.usable = true;
   fill.max_seconds = hi;
   fill.span_seconds = hi - lo;
@@ -224,7 +119,7 @@ bool pcdStampFromFileName(const std::string& path, std::int64_t& utime) {
 
 LidarScan readPcdScan(const std::string& path, const PcdFolderConfig& config, std::int64_t utime, std::int64_t seq,
                       PcdScanReport* report) {
-  const pcl::PCLPointCloud2 cloud = loadCloud(path);
+  const PcdCloud cloud = readPcdFile(path);
   const FieldReader x = findField(cloud, "x"), y = findField(cloud, "y"), z = findField(cloud, "z");
   if (!x.present || !y.present || !z.present) throw ReadError("PCD: '" + path + "' has no x, y and z fields");
   const FieldReader intensity = findField(cloud, "intensity");
@@ -244,7 +139,7 @@ LidarScan readPcdScan(const std::string& path, const PcdFolderConfig& config, st
   scan.seq = seq;
   scan.sensor = config.sensor;
   scan.sweep_duration = static_cast<float>(config.sweep_duration);
-  scan.points.resize(static_cast<std::size_t>(cloud.width) * cloud.height);
+  scan.points.resize(cloud.points);
   int max_ring = -1;
   for (std::size_t i = 0; i < scan.points.size(); ++i) {
     const std::uint8_t* raw = cloud.data.data() + i * cloud.point_step;
@@ -317,28 +212,23 @@ LidarScan PcdFolder::scan(std::size_t i, PcdScanReport* report) const {
 }
 
 void writePcd(const std::string& path, const std::vector<LidarPoint>& points, const PcdWriteOptions& options) {
-  pcl::PCLPointCloud2 cloud;
-  std::uint32_t offset = 0;
-  auto addField = [&](const char* name, std::uint8_t datatype, std::uint32_t bytes) {
-    pcl::PCLPointField f;
+  std::vector<PcdField> fields;
+  std::size_t step = 0;
+  auto addField = [&](const char* name, char type, std::uint32_t bytes) {
+    PcdField f;
     f.name = name;
-    f.offset = offset;
-    f.datatype = datatype;
-    f.count = 1;
-    cloud.fields.push_back(f);
-    offset += bytes;
+    f.type = type;
+    f.size = bytes;
+    f.offset = step;
+    fields.push_back(f);
+    step += bytes;
   };
-  for (const char* name : {"x", "y", "z", "intensity"}) addField(name, pcl::PCLPointField::FLOAT32, 4);
-  if (options.with_ring) addField("ring", pcl::PCLPointField::UINT16, 2);
-  if (options.with_time) addField("time", pcl::PCLPointField::FLOAT32, 4);
-  cloud.point_step = offset;
-  cloud.width = static_cast<std::uint32_t>(points.size());
-  cloud.height = 1;
-  cloud.row_step = cloud.point_step * cloud.width;
-  cloud.is_dense = std::all_of(points.begin(), points.end(), [](const LidarPoint& p) { return p.p.allFinite(); });
-  cloud.data.resize(static_cast<std::size_t>(cloud.row_step));
+  for (const char* name : {"x", "y", "z", "intensity"}) addField(name, 'F', 4);
+  if (options.with_ring) addField("ring", 'U', 2);
+  if (options.with_time) addField("time", 'F', 4);
+  std::vector<std::uint8_t> data(points.size() * step);
   for (std::size_t i = 0; i < points.size(); ++i) {
-    std::uint8_t* out = cloud.data.data() + i * cloud.point_step;
+    std::uint8_t* out = data.data() + i * step;
     const LidarPoint& pt = points[i];
     const float xyzi[4] = {pt.p.x(), pt.p.y(), pt.p.z(), pt.intensity};
     std::memcpy(out, xyzi, sizeof(xyzi));
@@ -349,12 +239,10 @@ void writePcd(const std::string& path, const std::vector<LidarPoint>& points, co
     }
     if (options.with_time) std::memcpy(out + at, &pt.dt, sizeof(pt.dt));
   }
-  pcl::PCDWriter writer;
-  const std::string header =
-      writer.generateHeaderBinary(cloud, Eigen::Vector4f::Zero(), Eigen::Quaternionf::Identity());
+  const std::string header = pcdBinaryHeader(fields, points.size());
   writeFileAtomically(path, [&](std::ostream& out) {
-    out << header << "DATA binary\n";
-    out.write(reinterpret_cast<const char*>(cloud.data.data()), static_cast<std::streamsize>(cloud.data.size()));
+    out << header;
+    out.write(reinterpret_cast<const char*>(data.data()), static_cast<std::streamsize>(data.size()));
   });
 }
 

@@ -1,5 +1,6 @@
 // A folder of PCD files (one sweep each, sorted by file name) read as LidarScans, and a binary PCD writer.
-// PCL (pcl_io) does the parsing, so ascii, binary and binary_compressed files all work; PCL stays in pcd.cpp.
+// pcd_format.hpp parses ascii, binary and binary_compressed files and checks every size in the header
+// against the bytes present (PCL's reader trusts the header; a crafted file crashed it).
 //
 // Fields: x, y, z required; intensity optional (else 0). `ring` optional, any integer or float type, taken
 // as 0 = lowest beam. Per-point time optional, the first of `time`, `t`, `timestamp` present:
@@ -20,7 +21,8 @@
 //     per-point time span, or + sweep_duration without times);
 //  3. otherwise config.first_utime + index * sweep_duration.
 //
-// Errors: a missing folder, an unreadable/corrupt/truncated file, missing x/y/z: ReadError naming the file.
+// Errors: a missing folder, an unreadable/corrupt/truncated file, an ascii value that is not a number,
+// missing x/y/z: ReadError naming the file (and the line, for header and ascii problems).
 // NaN points are kept for the preprocessing stage to count.
 #pragma once
 

@@ -1,5 +1,6 @@
 #include "runtime/lcm_log.hpp"
 
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <array>
@@ -31,6 +32,9 @@ void writeBE(std::uint8_t* p, std::uint64_t v, int n) {
 }  // namespace
 
 LogReader::LogReader(const std::string& path) {
+  struct stat st {};
+  if (::stat(path.c_str(), &st) != 0) throw std::runtime_error("cannot open log '" + path + "': " + std::strerror(errno));
+  if (!S_ISREG(st.st_mode)) throw std::runtime_error("cannot read log '" + path + "': not a regular file");
   file_ = std::fopen(path.c_str(), "rb");
   if (!file_) throw std::runtime_error("cannot open log '" + path + "': " + std::strerror(errno));
   std::fseek(file_, 0, SEEK_END);
@@ -116,34 +120,55 @@ LogWriter::LogWriter(std::string path) : path_(std::move(path)) {
   if (!file_) throw std::runtime_error("cannot create log '" + tmp_path_ + "': " + std::strerror(errno));
 }
 
-LogWriter::~LogWriter() {
-  try {
-    close();
-  } catch (...) {
-    // Destructors must not throw; the temp file stays behind for inspection.
-  }
+LogWriter::~LogWriter() { discard(); }
+
+void LogWriter::discard() {
+  if (!file_) return;
+  std::fclose(file_);
+  file_ = nullptr;
+  std::remove(tmp_path_.c_str());
+}
+
+void LogWriter::fail(const std::string& what) {
+  const std::string reason = errno ? std::strerror(errno) : "unknown error";
+  discard();
+  throw std::runtime_error("cannot write log '" + path_ + "': " + what + ": " + reason + " (nothing written)");
 }
 
 void LogWriter::write(const std::string& channel, const std::uint8_t* data, std::size_t size, std::int64_t timestamp) {
   if (!file_) throw std::runtime_error("log '" + path_ + "' is closed");
+  if (channel.empty() || channel.size() > static_cast<std::size_t>(kMaxChannelLength) ||
+      size > static_cast<std::size_t>(kMaxDataLength))
+    throw std::runtime_error("log '" + path_ + "': event on '" + channel.substr(0, 64) + "' of " + std::to_string(size) +
+                             " bytes cannot be framed");
   std::array<std::uint8_t, kHeaderSize> header{};
   writeBE(header.data(), kSync, 4);
   writeBE(header.data() + 4, static_cast<std::uint64_t>(next_event_++), 8);
   writeBE(header.data() + 12, static_cast<std::uint64_t>(timestamp), 8);
   writeBE(header.data() + 20, channel.size(), 4);
   writeBE(header.data() + 24, size, 4);
-  std::fwrite(header.data(), 1, header.size(), file_);
-  std::fwrite(channel.data(), 1, channel.size(), file_);
-  if (size) std::fwrite(data, 1, size, file_);
+  errno = 0;
+  if (std::fwrite(header.data(), 1, header.size(), file_) != header.size() ||
+      std::fwrite(channel.data(), 1, channel.size(), file_) != channel.size() ||
+      (size && std::fwrite(data, 1, size, file_) != size))
+    fail("write failed (disk full?)");
 }
 
 void LogWriter::close() {
   if (!file_) return;
-  const bool ok = std::fflush(file_) == 0 && ::fsync(::fileno(file_)) == 0;
-  std::fclose(file_);
+  errno = 0;
+  if (std::fflush(file_) != 0 || ::fsync(::fileno(file_)) != 0) fail("flush failed (disk full?)");
+  std::FILE* file = file_;
   file_ = nullptr;
-  if (!ok || std::rename(tmp_path_.c_str(), path_.c_str()) != 0)
-    throw std::runtime_error("cannot write log '" + path_ + "': " + std::strerror(errno));
+  if (std::fclose(file) != 0) {
+    std::remove(tmp_path_.c_str());
+    throw std::runtime_error("cannot write log '" + path_ + "': close failed: " + std::strerror(errno) + " (nothing written)");
+  }
+  if (std::rename(tmp_path_.c_str(), path_.c_str()) != 0) {
+    const std::string reason = std::strerror(errno);
+    std::remove(tmp_path_.c_str());
+    throw std::runtime_error("cannot rename '" + tmp_path_ + "' to '" + path_ + "': " + reason);
+  }
 }
 
 }  // namespace adit::runtime

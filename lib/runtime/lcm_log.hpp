@@ -46,11 +46,14 @@ class LogReader {
 };
 
 // Writes to "<path>.tmp.<pid>" and renames onto <path> on close(), so a reader never sees a half log.
+// Every write is checked: on failure (disk full) the temp file is removed and std::runtime_error names
+// the log. A writer destroyed without close() (an exception unwinding) removes its temp file: a log that
+// is not complete never appears under its final name.
 class LogWriter {
  public:
   // Throws std::runtime_error if the file cannot be created.
   explicit LogWriter(std::string path);
-  ~LogWriter();  // closes (and commits) if close() was not called
+  ~LogWriter();  // discards the temp file if close() was not called
   LogWriter(const LogWriter&) = delete;
   LogWriter& operator=(const LogWriter&) = delete;
 
@@ -58,12 +61,15 @@ class LogWriter {
   void write(const std::string& channel, const std::vector<std::uint8_t>& data, std::int64_t timestamp) {
     write(channel, data.data(), data.size(), timestamp);
   }
-  // Flush, fsync and rename into place. Throws std::runtime_error on I/O failure.
+  // Flush, fsync and rename into place. Throws std::runtime_error on I/O failure (temp file removed).
   void close();
+  // Abandon the log: close and remove the temp file (no-op once closed).
+  void discard();
   std::int64_t events() const { return next_event_; }
   const std::string& path() const { return path_; }
 
  private:
+  [[noreturn]] void fail(const std::string& what);
   std::string path_;
   std::string tmp_path_;
   std::FILE* file_ = nullptr;

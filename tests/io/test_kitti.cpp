@@ -194,6 +194,56 @@ TEST(Kitti, NanPointsAreKeptAndCounted) {
   EXPECT_EQ(scan.utime, 5000000);
 }
 
+// Issue 14: a bad times.txt said only "stol". The error names the file, the line and what is wrong.
+TEST(Kitti, TimesErrorsNameTheFileTheLineAndTheProblem) {
+  const auto errorFor = [](const std::string& text) {
+    try {
+      parseKittiTimes(text, "seq/times.txt");
+    } catch (const ReadError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  EXPECT_EQ(errorFor("0.0\nzero point one\n"), "KITTI: 'seq/times.txt' line 2: 'zero point one' is not a time in seconds");
+  EXPECT_EQ(errorFor("0.0\n0.1 0.2\n"), "KITTI: 'seq/times.txt' line 2: 2 numbers, expected one time in seconds");
+  EXPECT_EQ(errorFor("-1.0\n"), "KITTI: 'seq/times.txt' line 1: negative time -1.000000");
+  EXPECT_EQ(errorFor("0.2\n0.1\n"), "KITTI: 'seq/times.txt' line 2: time goes backwards (0.100000 after 0.200000)");
+  EXPECT_EQ(errorFor("0.0\n\n0.1\n"), "");
+  EXPECT_EQ(parseKittiTimes("0.0\n\n1e-1\n", "t").size(), 2u);
+}
+
+TEST(Kitti, EmptyHugeAndOddSizedScansAreErrorsNamingTheFile) {
+  TempDir dir;
+  fs::create_directories(dir.file("velodyne"));
+  dir.write("times.txt", "0.0\n0.1\n0.2\n");
+  dir.write("velodyne/000000.bin", "");
+  dir.write("velodyne/000001.bin", std::string(17, '\0'));
+  dir.write("velodyne/000002.bin", "");
+  fs::resize_file(dir.file("velodyne/000002.bin"), kKittiMaxScanBytes + 16);  // sparse: costs no disk
+  const KittiSequence seq(dir.path());
+  const auto errorOf = [&](std::size_t i) {
+    try {
+      seq.scan(i);
+    } catch (const ReadError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  EXPECT_NE(errorOf(0).find("000000.bin' is empty"), std::string::npos) << errorOf(0);
+  EXPECT_NE(errorOf(1).find("000001.bin' is truncated or corrupt: 17 bytes"), std::string::npos) << errorOf(1);
+  EXPECT_NE(errorOf(2).find("000002.bin' is 268435472 bytes, more than any sweep"), std::string::npos) << errorOf(2);
+}
+
+// A scan named by a number too long for a long (stol threw std::out_of_range): read in name order instead.
+TEST(Kitti, OverlongNumericScanNameIsNotACrash) {
+  TempDir dir;
+  fs::create_directories(dir.file("velodyne"));
+  dir.write("times.txt", "0.0\n");
+  dir.write("velodyne/99999999999999999999999.bin", std::string(16, '\0'));
+  const KittiSequence seq(dir.path());
+  EXPECT_EQ(seq.scan(0).points.size(), 1u);
+}
+
 TEST(Kitti, MissingSequenceDirectoryIsAnError) {
   EXPECT_THROW(KittiSequence::open(kRoot, "99"), ReadError);
 }

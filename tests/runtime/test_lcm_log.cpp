@@ -102,3 +102,50 @@ TEST(LcmLog, MissingFileThrowsAClearError) {
     EXPECT_NE(std::string(e.what()).find("/nonexistent/adit.lcmlog"), std::string::npos);
   }
 }
+
+// A writer abandoned by an exception (a replay that failed half way) leaves nothing behind: no half log
+// under the final name (it used to commit it), no temp file.
+TEST(LcmLog, WriterDestroyedWithoutCloseLeavesNothing) {
+  const auto path = tempPath("abandoned.lcmlog");
+  fs::remove(path);
+  {
+    LogWriter w(path.string());
+    w.write("IMU", payload(3), 1);
+  }
+  EXPECT_FALSE(fs::exists(path));
+  EXPECT_FALSE(fs::exists(path.string() + ".tmp." + std::to_string(::getpid())));
+}
+
+// A frame header announcing far more bytes than the file holds allocates nothing and ends the log.
+TEST(LcmLog, LengthFieldsBeyondTheFileAreNotAllocated) {
+  const auto path = tempPath("liar.lcmlog");
+  const unsigned char frame[28] = {0xED, 0xA1, 0xDA, 0x01, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 1,
+                                   0, 0, 0, 3, 0x1F, 0xFF, 0xFF, 0xFF};  // data length 512 MB
+  std::ofstream(path, std::ios::binary | std::ios::trunc) << std::string(reinterpret_cast<const char*>(frame), 28) << "IMU";
+  LogReader r(path.string());
+  EXPECT_TRUE(readAll(r).empty());
+  EXPECT_TRUE(r.truncated());
+  EXPECT_THROW(LogReader(fs::temp_directory_path().string()), std::runtime_error);  // a folder is not a log
+}
+
+// Disk full: every write is checked, the error names the log, and neither the log nor its temp file stays.
+// The temp file is pointed at /dev/full (writes fail with ENOSPC), which needs no privilege.
+TEST(LcmLog, DiskFullIsAnErrorAndLeavesNoFile) {
+  if (!fs::exists("/dev/full")) GTEST_SKIP() << "no /dev/full";
+  const auto path = tempPath("full.lcmlog");
+  fs::remove(path);
+  const std::string tmp = path.string() + ".tmp." + std::to_string(::getpid());
+  fs::remove(tmp);
+  fs::create_symlink("/dev/full", tmp);
+  try {
+    LogWriter w(path.string());
+    for (int i = 0; i < 2000; ++i) w.write("LIDAR_POINTS", payload(100), i);  // beyond stdio's buffer
+    w.close();
+    FAIL() << "expected a write error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find(path.string()), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("No space left on device"), std::string::npos) << e.what();
+  }
+  EXPECT_FALSE(fs::exists(path));
+  EXPECT_FALSE(fs::is_symlink(tmp));
+}
