@@ -1,5 +1,7 @@
 #include "io/imu_csv.hpp"
 
+#include "io/limits.hpp"
+
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
@@ -76,6 +78,10 @@ bool parseImuCsvLine(const std::string& line, const ImuCsvConfig& config, ImuSam
   }
   if (v[0] < 0.0) {
     reason = "negative timestamp";
+    return false;
+  }
+  if (v[0] > kMaxStampSeconds * 1e9) {  // even as nanoseconds: beyond the year 2286
+    reason = "timestamp beyond the year 2286";
     return false;
   }
   sample = ImuSample{};

@@ -7,6 +7,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "io/limits.hpp"
 #include "io/rings.hpp"
 
 namespace adit::io {
@@ -70,6 +71,8 @@ std::vector<double> parseKittiTimes(const std::string& text, const std::string& 
     if (values.size() > 1) throw ReadError(where() + std::to_string(values.size()) + " numbers, expected one time in seconds");
     if (values.empty()) continue;
     if (values[0] < 0.0) throw ReadError(where() + "negative time " + std::to_string(values[0]));
+    if (values[0] > kMaxStampSeconds)
+      throw ReadError(where() + "time " + std::to_string(values[0]) + " s is beyond the year 2286");
     if (!times.empty() && values[0] < times.back())
       throw ReadError(where() + "time goes backwards (" + std::to_string(values[0]) + " after " +
                       std::to_string(times.back()) + ")");

@@ -1,12 +1,14 @@
 #include "io/pcd.hpp"
 
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <limits>
 
 #include "io/atomic_file.hpp"
+#include "io/limits.hpp"
 #include "io/pcd_format.hpp"
 #include "io/rings.hpp"
 
@@ -50,7 +52,7 @@ TimeFill fillTimes(const PcdCloud& cloud, const FieldReader& time, std::vector<L
   double hi = -std::numeric_limits<double>::infinity();
   for (std::size_t i = 0; i < points.size(); ++i) {
     const double s = time.read(cloud.data.data() + i * cloud.point_step) * scale;
-    if (!std::isfinite(s)) continue;
+    if (!std::isfinite(s) || std::fabs(s) > kMaxStampSeconds) continue;  // absurd: as if absent
     seconds[i] = s;
     lo = std::min(lo, s);
     hi = std::max(hi, s);
@@ -84,7 +86,7 @@ bool parseDecimalSeconds(const std::string& stem, double& seconds) {
   if (stem.find('.') == std::string::npos) return false;
   char* end = nullptr;
   seconds = std::strtod(stem.c_str(), &end);
-  return end != stem.c_str() && *end == '\0' && std::isfinite(seconds) && seconds >= 0.0;
+  return end != stem.c_str() && *end == '\0' && std::isfinite(seconds) && seconds >= 0.0 && seconds <= kMaxStampSeconds;
 }
 
 }  // namespace
@@ -111,7 +113,9 @@ bool pcdStampFromFileName(const std::string& path, std::int64_t& utime) {
   const bool digits = !stem.empty() && stem.size() <= 19 &&
                       std::all_of(stem.begin(), stem.end(), [](char c) { return c >= '0' && c <= '9'; });
   if (!digits) return false;
-  const long long ns = std::stoll(stem);
+  errno = 0;
+  const long long ns = std::strtoll(stem.c_str(), nullptr, 10);
+  if (errno == ERANGE) return false;  // 19 digits above INT64_MAX
   if (ns <= 1000000000000LL) return false;  // small integers are frame numbers, not nanoseconds
   utime = (ns + 500) / 1000;
   return true;

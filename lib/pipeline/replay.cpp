@@ -17,6 +17,7 @@
 #include <fstream>
 #include <memory>
 #include <regex>
+#include <stdexcept>
 
 namespace adit::pipeline {
 namespace fs = std::filesystem;
@@ -111,9 +112,20 @@ ReplayReport runReplay(const ReplayOptions& options) {
   runtime::LogWriter output((fs::path(options.out_dir) / "output.lcmlog").string());
   runtime::LockstepBus bus;
   const std::regex record(options.record);
+  // A failed write (disk full) happens inside a node's publish, where stage errors are counted and the run
+  // goes on: keep it here and end the replay with it after the delivery (the writer has removed its file).
+  std::string write_error;
   bus.observe([&](const std::string& channel, const runtime::Bytes& data, std::int64_t utime) {
-    if (std::regex_match(channel, record)) output.write(channel, data, utime);
+    if (!write_error.empty() || !std::regex_match(channel, record)) return;
+    try {
+      output.write(channel, data, utime);
+    } catch (const std::exception& e) {
+      write_error = e.what();
+    }
   });
+  const auto stopOnWriteError = [&] {
+    if (!write_error.empty()) throw std::runtime_error(write_error);
+  };
   for (const auto& node : nodes) bus.add(*node);
 
   runtime::LogEvent event;
@@ -124,9 +136,13 @@ ReplayReport runReplay(const ReplayOptions& options) {
     if (first_utime < 0) first_utime = event.timestamp;
     last_utime = std::max(last_utime, event.timestamp);
     bus.inject(event.channel, event.data, event.timestamp);
+    stopOnWriteError();
     if (options.on_progress && report.input_events % 64 == 0 && input.progress() >= 0) options.on_progress(input.progress());
   }
+  if (report.input_events == 0 && !options.source)
+    throw std::runtime_error("'" + options.input_log + "' holds no LCM event (empty, or not an LCM log): nothing replayed");
   bus.finish();
+  stopOnWriteError();
   output.close();
   if (options.on_progress) options.on_progress(1.0);
 

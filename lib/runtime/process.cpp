@@ -70,7 +70,12 @@ void addProcessOptions(CLI::App& app, ProcessOptions& o) {
 
 Config loadConfig(const std::vector<std::string>& paths) {
   Config config;
-  for (const auto& path : paths) config.merge(Config::fromYamlFile(path));
+  for (const auto& path : paths) {
+    const Config file = Config::fromYamlFile(path);
+    // An empty file is a mistake (a wrong path, a file cut to nothing), not "no changes".
+    if (file.values().empty()) throw std::runtime_error("config: '" + path + "' holds no configuration key (empty file?)");
+    config.merge(file);
+  }
   return config;
 }
 

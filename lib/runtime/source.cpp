@@ -13,12 +13,26 @@
 namespace adit::runtime {
 namespace {
 
+// A log written from files is complete or not written at all: the first input that cannot be read stops
+// the run (unless keep_going), and so does an input that yields nothing; the LogWriter then removes its
+// temp file.
 int writeLog(MessageSource& source, const SourceRunOptions& options) {
   LogWriter log(options.output_log);
   OutgoingMessage m;
-  while (!stopRequested() && source.next(m)) log.write(m.channel, m.data, m.utime);
-  log.close();
+  while (!stopRequested() && source.next(m)) {
+    if (source.health().errors > 0 && !options.keep_going) break;
+    log.write(m.channel, m.data, m.utime);
+  }
   const Health& h = source.health();
+  if (h.errors > 0 && !options.keep_going) {
+    spdlog::error("{} (no log written; --keep-going skips unreadable inputs)", h.last_error);
+    return 1;
+  }
+  if (log.events() == 0 && !stopRequested()) {
+    spdlog::error("'{}' holds no usable message: no log written to '{}'", options.input, options.output_log);
+    return 1;
+  }
+  log.close();
   spdlog::info("wrote {} messages to {} ({} errors, {} skipped)", log.events(), options.output_log, h.errors, h.drops);
   return 0;
 }

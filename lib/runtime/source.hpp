@@ -43,9 +43,12 @@ struct SourceRunOptions {
   std::string process;         // for STATUS and log lines, e.g. "lidar-bridge"
   std::string lcm_url;         // live publishing
   std::string output_log;      // if set: write a log instead of publishing
+  std::string input;           // what is read (file or folder), for error messages
   double rate = 1.0;           // live: multiple of recorded speed (0 = as fast as possible)
   double status_period_s = 1.0;
   bool quiet = false;
+  // Writing a log: skip (and count) unreadable inputs instead of stopping with no log written.
+  bool keep_going = false;
 };
 
 // Returns the exit code (0 also when stopped by a signal).

@@ -61,12 +61,13 @@ class ScanFileSource : public runtime::MessageSource {
 
 class ImuSource : public runtime::MessageSource {
  public:
-  ImuSource(io::ImuCsvResult data, std::string channel) : data_(std::move(data)), channel_(std::move(channel)) {
+  ImuSource(io::ImuCsvResult data, std::string channel, const std::string& path)
+      : data_(std::move(data)), channel_(std::move(channel)) {
     health_.errors = static_cast<std::int64_t>(data_.bad_lines.size());
     if (!data_.bad_lines.empty()) {
       health_.counters["bad_line"] = health_.errors;
-      health_.last_error = data_.badLineSummary();
-      spdlog::error("IMU file: {}", data_.badLineSummary());
+      health_.last_error = "IMU file '" + path + "': " + data_.badLineSummary();
+      spdlog::error("{}", health_.last_error);
     }
   }
   bool next(runtime::OutgoingMessage& out) override {
@@ -111,7 +112,7 @@ std::unique_ptr<runtime::MessageSource> makePcdSource(const std::string& folder,
 }
 
 std::unique_ptr<runtime::MessageSource> makeImuCsvSource(const std::string& path, const std::string& channel) {
-  return std::make_unique<ImuSource>(io::readImuCsv(path), channel);
+  return std::make_unique<ImuSource>(io::readImuCsv(path), channel, path);
 }
 
 }  // namespace adit::sources

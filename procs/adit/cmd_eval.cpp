@@ -7,6 +7,8 @@
 #include "eval/report.hpp"
 #include "eval/trajectory_io.hpp"
 
+#include <spdlog/spdlog.h>
+
 #include <iostream>
 #include <memory>
 #include <string>
@@ -92,7 +94,7 @@ void registerEvalCommand(CLI::App& app) {
     try {
       code = runEval(*o);
     } catch (const std::exception& e) {
-      std::cerr << "adit eval: " << e.what() << "\n";
+      spdlog::error("{}", e.what());
       code = 1;
     }
     if (code != 0) throw CLI::RuntimeError(code);

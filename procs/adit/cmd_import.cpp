@@ -10,10 +10,15 @@ void registerImportCommand(CLI::App& app) {
   auto* cmd = app.add_subcommand("import", "Convert a data set (KITTI odometry layout, PCD folder) into an LCM log");
   addLidarSourceOptions(*cmd, *source, true);
   cmd->add_option("-o,--output", *output, "LCM log to write")->required();
-  cmd->callback([source, output] {
+  auto keep_going = std::make_shared<bool>(false);
+  cmd->add_flag("--keep-going", *keep_going,
+                "Skip (and count) unreadable sweeps; by default the first one stops the import with no log written");
+  cmd->callback([source, output, keep_going] {
     adit::runtime::SourceRunOptions run;
     run.process = "import";
     run.output_log = *output;
+    run.keep_going = *keep_going;
+    run.input = source->path;
     auto src = adit::sources::makeLidarSource(*source);
     if (const int code = adit::runtime::runSource(*src, run); code != 0) throw CLI::RuntimeError(code);
   });

@@ -5,6 +5,7 @@
 #include "runtime/lcm_log.hpp"
 
 #include <fmt/format.h>
+#include <spdlog/spdlog.h>
 
 #include <map>
 
@@ -34,13 +35,18 @@ void registerInfoCommand(CLI::App& app) {
       s.last = e.timestamp;
       s.bytes += static_cast<std::int64_t>(e.data.size());
     }
+    if (channels.empty())
+      throw std::runtime_error("'" + *path + "' holds no LCM event (empty, or not an LCM log)");
     fmt::print("{:<24} {:>8} {:<16} {:>10} {:>9} {:>10}\n", "channel", "messages", "type", "span_s", "rate_hz", "MB");
     for (const auto& [name, s] : channels) {
       const double span = static_cast<double>(s.last - s.first) * 1e-6;
       fmt::print("{:<24} {:>8} {:<16} {:>10.3f} {:>9.2f} {:>10.2f}\n", name, s.count, s.type.empty() ? "?" : s.type,
                  span, span > 0 ? static_cast<double>(s.count - 1) / span : 0.0, static_cast<double>(s.bytes) / 1e6);
     }
-    if (reader.corruptFrames() || reader.truncated())
-      fmt::print("corrupt frames skipped: {}{}\n", reader.corruptFrames(), reader.truncated() ? ", truncated at the end" : "");
+    if (reader.corruptFrames() || reader.truncated()) {
+      spdlog::error("log '{}' is damaged: {} corrupt frame(s) skipped{}", *path, reader.corruptFrames(),
+                    reader.truncated() ? ", truncated at the end" : "");
+      throw CLI::RuntimeError(kExitDamagedInput);
+    }
   });
 }

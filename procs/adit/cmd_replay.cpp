@@ -44,8 +44,6 @@ void registerReplayCommand(CLI::App& app) {
     if (!args->no_progress && ::isatty(STDERR_FILENO)) options.on_progress = drawProgress;
     adit::runtime::installStopHandlers();
     const auto r = adit::pipeline::runReplay(options);
-    if (r.corrupt_frames || r.truncated)
-      spdlog::warn("input log: {} corrupt frame(s) skipped{}", r.corrupt_frames, r.truncated ? ", truncated at the end" : "");
     fmt::print("replayed {} input messages ({:.1f} s of sensor time) in {:.2f} s with stages [{}]: {} messages out, {} "
                "skipped or bad, peak memory {:.0f} MB\n",
                r.input_events, r.sensor_seconds, r.wall_seconds, fmt::join(r.stages_run, ", "), r.output_events,
@@ -54,5 +52,10 @@ void registerReplayCommand(CLI::App& app) {
       fmt::print("  {:<12} {:>6} calls  median {:.2f} ms  p95 {:.2f} ms  max {:.2f} ms\n", t.stage, t.calls, t.median_ms,
                  t.p95_ms, t.max_ms);
     for (const auto& p : r.products) fmt::print("  wrote {}\n", p);
+    if (r.corrupt_frames || r.truncated) {  // outputs stay: they are what the readable part gives
+      spdlog::error("input log '{}' is damaged: {} corrupt frame(s) skipped{}; the outputs cover its readable part",
+                    args->log, r.corrupt_frames, r.truncated ? ", truncated at the end" : "");
+      throw CLI::RuntimeError(kExitDamagedInput);
+    }
   });
 }

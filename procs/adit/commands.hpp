@@ -21,3 +21,6 @@ void registerBenchCommand(CLI::App& app);
 std::string executableDir();
 // A progress bar on stderr (call with 0..1; 1 ends the line).
 void drawProgress(double fraction);
+// Exit status of `adit info` / `adit replay` when the input log was damaged (corrupt frames, truncated):
+// the readable part was used, but the result is not the whole log's.
+constexpr int kExitDamagedInput = 3;

@@ -17,7 +17,9 @@ int main(int argc, char** argv) {
       ->check(CLI::NonNegativeNumber);
   app.add_option("-o,--output", run.output_log, "Write an LCM log instead of publishing live");
   app.add_option("--lcm-url", run.lcm_url, "LCM provider (default: $LCM_DEFAULT_URL or udpm)");
+  app.add_flag("--keep-going", run.keep_going, "With -o: skip (and count) bad lines instead of writing no log");
   CLI11_PARSE(app, argc, argv);
+  run.input = path;
   spdlog::set_pattern("%H:%M:%S.%e %^%l%$ adit-imu-bridge: %v");
   try {
     auto src = adit::sources::makeImuCsvSource(path, channel);

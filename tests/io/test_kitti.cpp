@@ -209,6 +209,9 @@ TEST(Kitti, TimesErrorsNameTheFileTheLineAndTheProblem) {
   EXPECT_EQ(errorFor("-1.0\n"), "KITTI: 'seq/times.txt' line 1: negative time -1.000000");
   EXPECT_EQ(errorFor("0.2\n0.1\n"), "KITTI: 'seq/times.txt' line 2: time goes backwards (0.100000 after 0.200000)");
   EXPECT_EQ(errorFor("0.0\n\n0.1\n"), "");
+  // Found by fuzz_kitti: a time of 1e300 s overflowed the conversion to utime (undefined behaviour).
+  EXPECT_EQ(errorFor("0.0\n1e300\n"), "KITTI: 'seq/times.txt' line 2: time " + std::to_string(1e300) +
+                                           " s is beyond the year 2286");
   EXPECT_EQ(parseKittiTimes("0.0\n\n1e-1\n", "t").size(), 2u);
 }
 

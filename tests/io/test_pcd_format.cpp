@@ -118,6 +118,20 @@ TEST(PcdFormat, CorruptLzfIsAnErrorNeverAnOutOfBoundsCopy) {
   EXPECT_FALSE(lzfDecompress(cut_reference, sizeof(cut_reference), out, 5));
 }
 
+// Stamps too large for utime (int64 microseconds) are not stamps: no overflow, no exception.
+TEST(PcdFormat, AbsurdStampsAreIgnored) {
+  std::int64_t utime = 0;
+  EXPECT_FALSE(pcdStampFromFileName("d/9999999999999999999.pcd", utime));  // 19 digits above INT64_MAX
+  EXPECT_FALSE(pcdStampFromFileName("d/1.0e300.pcd", utime));
+  EXPECT_TRUE(pcdStampFromFileName("d/1611234567.123456.pcd", utime));
+  EXPECT_EQ(utime, 1611234567123456);
+  TempDir dir;
+  dir.write("t.pcd", header("x y z time", "4 4 4 8", "F F F F", "1 1 1 1", "2", "ascii") + "1 2 3 1e300\n4 5 6 2e300\n");
+  const LidarScan scan = readPcdScan(dir.file("t.pcd"), PcdFolderConfig{}, 7, 0);
+  EXPECT_FALSE(scan.has_time);
+  EXPECT_EQ(scan.utime, 7);
+}
+
 TEST(PcdFormat, ReadsCountFieldsAndAsciiNan) {
   TempDir dir;
   dir.write("n.pcd", header("x y z normal", "8 8 8 4", "F F F F", "1 1 1 3", "2", "ascii") + "1 2 3 0 0 1\nnan nan nan 0 1 0\n");
