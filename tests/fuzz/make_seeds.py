@@ -1,0 +1,77 @@
+#!/usr/bin/env python3
+"""Writes the small seed corpora of tests/fuzz/corpus/ from the project's own files (launch files,
+configuration, the KITTI mini set) and hand-built examples of each format. Run from the repository root;
+node_messages and lidar_packets seeds are cut from logs/packets the tests produce (see README there)."""
+import glob, os, struct
+
+OUT = "tests/fuzz/corpus"
+
+def put(harness, name, data):
+    os.makedirs(f"{OUT}/{harness}", exist_ok=True)
+    with open(f"{OUT}/{harness}/{name}", "wb") as f:
+        f.write(data if isinstance(data, bytes) else data.encode())
+
+def pcd_header(fields, sizes, types, n, data, counts=None):
+    counts = counts or [1] * len(fields)
+    return (f"# .PCD v0.7 - Point Cloud Data file format\nVERSION 0.7\nFIELDS {' '.join(fields)}\n"
+            f"SIZE {' '.join(map(str, sizes))}\nTYPE {' '.join(types)}\nCOUNT {' '.join(map(str, counts))}\n"
+            f"WIDTH {n}\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS {n}\nDATA {data}\n").encode()
+
+def lzf_literals(raw):
+    out = bytearray()
+    for i in range(0, len(raw), 32):
+        chunk = raw[i:i + 32]
+        out.append(len(chunk) - 1)
+        out += chunk
+    return bytes(out)
+
+def pcd_seeds():
+    pts = [(1.0 + i, 0.5 * i, -0.2 * i, 10.0 * i, i % 16, -0.1 + 0.01 * i) for i in range(8)]
+    f, s, t = ["x", "y", "z", "intensity", "ring", "time"], [4, 4, 4, 4, 2, 4], ["F", "F", "F", "F", "U", "F"]
+    ascii_body = "".join(f"{x} {y} {z} {i} {r} {tt}\n" for x, y, z, i, r, tt in pts)
+    put("pcd", "ascii.pcd", pcd_header(f, s, t, len(pts), "ascii") + ascii_body.encode())
+    put("pcd", "ascii_nan.pcd", pcd_header(f[:3], s[:3], t[:3], 2, "ascii") + b"nan nan nan\n1 2 3\n")
+    binary = b"".join(struct.pack("<ffffHf", *p) for p in pts)
+    put("pcd", "binary.pcd", pcd_header(f, s, t, len(pts), "binary") + binary)
+    cols = b"".join(b"".join(struct.pack("<" + ("H" if k == 4 else "f"), p[k]) for p in pts) for k in range(6))
+    comp = lzf_literals(cols)
+    put("pcd", "compressed.pcd", pcd_header(f, s, t, len(pts), "binary_compressed") +
+        struct.pack("<II", len(comp), len(cols)) + comp)
+    # LZF back references: 8 zero points, the first literal, the rest copied.
+    zeros = bytes(12 * 8)
+    comp = bytes([0, 0]) + bytes([(7 << 5) | 0, len(zeros) - 1 - 2 - 7, 0])
+    put("pcd", "compressed_backref.pcd", pcd_header(f[:3], s[:3], t[:3], 8, "binary_compressed") +
+        struct.pack("<II", len(comp), len(zeros)) + comp)
+    ouster = b"".join(struct.pack("<fffIB", 1.0, 2.0, 3.0, 1000 * i, i) for i in range(4))
+    put("pcd", "ouster.pcd", pcd_header(["x", "y", "z", "t", "ring"], [4, 4, 4, 4, 1], ["F", "F", "F", "U", "U"], 4, "binary") + ouster)
+    put("pcd", "counts.pcd", pcd_header(["x", "y", "z", "normal"], [8, 8, 8, 4], ["F", "F", "F", "F"], 1, "ascii", [1, 1, 1, 3])
+        + b"1 2 3 0 0 1\n")
+
+def kitti_seeds():
+    seq = "../shared/data/kitti_mini/sequences/00"
+    times = open(f"{seq}/times.txt").read().splitlines()[:3]
+    text = ("\n".join(times) + "\n").encode()
+    raw = open(f"{seq}/velodyne/000000.bin", "rb").read()
+    for name, n in (("small", 64), ("rings", 400)):
+        put("kitti", name, struct.pack("<H", len(text)) + text + raw[:16 * n])
+    put("kitti", "one_time", struct.pack("<H", 5) + b"0.0\n\n" + raw[:160])
+
+def lcmlog_seeds():
+    def event(n, t, ch, data):
+        return struct.pack(">IqqII", 0xEDA1DA01, n, t, len(ch), len(data)) + ch + data
+    log = event(0, 1000, b"LIDAR_POINTS", bytes(40)) + event(1, 2000, b"IMU", bytes(range(30)))
+    put("lcmlog", "two_events.lcmlog", log)
+    put("lcmlog", "garbage_between.lcmlog", log[:50] + b"\x00" * 7 + log)
+    put("lcmlog", "truncated.lcmlog", log[:-5])
+
+def text_seeds():
+    put("imu_text", "mixed.txt", "# bench\nt,gx,gy,gz,ax,ay,az,mx,my,mz\n10.000, 0.1, 0.2, 0.3, 0.0, 0.0, 9.81\n"
+        "10.005 0.1 0.2 0.3 0.0 0.0 9.81 20 -5 40\n\n10.010,0.1,0.2,0.3,0.0,0.0\n10.015,0.1,abc,0.3,0.0,0.0,9.81\n"
+        "1700000000123456789 0 0 0 0 0 9.8\n")
+    for path in sorted(glob.glob("launch/config/*.yaml") + glob.glob("launch/sensors/*.yaml"))[:6]:
+        put("config", os.path.basename(path), open(path, "rb").read())
+    for path in sorted(glob.glob("launch/*.launch.yaml") + ["tests/integration/udp.launch.yaml"]):
+        put("launch_file", os.path.basename(path), open(path, "rb").read())
+
+if __name__ == "__main__":
+    pcd_seeds(); kitti_seeds(); lcmlog_seeds(); text_seeds()
