@@ -2,7 +2,7 @@
 # Build the libFuzzer harnesses of tests/fuzz with Debian's clang (AddressSanitizer + UndefinedBehaviorSanitizer)
 # into build-fuzz/, and run them one at a time at the lowest CPU priority.
 #
-#   scripts/fuzz.sh [HARNESS...] [--seconds N] [--build-only]
+#   scripts/fuzz.sh [HARNESS...] [--seconds N] [--build-only | --no-build]
 #
 # HARNESS: pcd kitti lcmlog imu_text config launch_file lidar_packets node_messages (default: all).
 # Each runs N seconds (default 60) from its seed corpus (tests/fuzz/corpus/<harness>, copied: the repository's
@@ -15,12 +15,14 @@ ROOT=$(pwd)
 BUILD=$ROOT/build-fuzz
 SECONDS_EACH=60
 BUILD_ONLY=0
+NO_BUILD=0
 ALL=(pcd kitti lcmlog imu_text config launch_file lidar_packets node_messages)
 HARNESSES=()
 while [[ $# -gt 0 ]]; do
   case "$1" in
     --seconds) SECONDS_EACH=$2; shift 2 ;;
     --build-only) BUILD_ONLY=1; shift ;;
+    --no-build) NO_BUILD=1; shift ;;
     -h|--help) sed -n '2,12p' "$0"; exit 0 ;;
     -*) echo "fuzz.sh: unknown option $1" >&2; exit 2 ;;
     *) HARNESSES+=("$1"); shift ;;
@@ -39,7 +41,7 @@ if [[ ! -f $BUILD/CMakeCache.txt ]]; then
 fi
 targets=()
 for h in "${HARNESSES[@]}"; do targets+=("fuzz_$h"); done
-nice -n 19 cmake --build "$BUILD" -j2 --target "${targets[@]}"
+[[ $NO_BUILD -eq 1 ]] || nice -n 19 cmake --build "$BUILD" -j2 --target "${targets[@]}"
 [[ $BUILD_ONLY -eq 1 ]] && exit 0
 
 export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1:abort_on_error=0}

@@ -165,10 +165,12 @@ TEST_F(BadFiles, EveryReaderFailsCleanly) {
   // adit import kitti: a bad scan, then a bad times.txt.
   auto bin_inputs = generic(good_bin_, kPcd, 2);
   bin_inputs.push_back({"odd size", good_bin_.substr(0, 16 * 1000 + 7)});
+  bin_inputs.push_back({"huge (300 MB, sparse)", std::string("\0huge", 5)});  // marker: resized below
   for (const auto& [what, bytes] : bin_inputs)
     cases.push_back({"KITTI .bin (import kitti)", what, [bytes = bytes](const fs::path& d) {
                        spit(d / "seq" / "times.txt", "0.0\n");
                        spit(d / "seq" / "velodyne" / "000000.bin", bytes);
+                       if (bytes == std::string("\0huge", 5)) fs::resize_file(d / "seq" / "velodyne" / "000000.bin", 300u << 20);
                        return bin("adit") + " import kitti " + (d / "seq").string() + " -o " + (d / "out.lcmlog").string() +
                               "|000000.bin";
                      }, {"out.lcmlog"}});
@@ -184,12 +186,19 @@ TEST_F(BadFiles, EveryReaderFailsCleanly) {
                               "|times.txt";
                      }, {"out.lcmlog"}});
   // adit info and adit replay on a bad log. A truncated log is used as far as it reads, with exit status 3.
-  for (const auto& [what, bytes] : generic(good_log_, kPcd, 4)) {
+  auto log_inputs = generic(good_log_, kPcd, 4);
+  std::string corrupt = good_log_;
+  corrupt[28 + 4] = static_cast<char>(0x7F);  // a byte of the first frame's channel name turns unprintable
+  log_inputs.push_back({"corrupt first frame", corrupt});
+  const unsigned char liar[28] = {0xED, 0xA1, 0xDA, 0x01, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 1,
+                                  0, 0, 0, 3, 0x1F, 0xFF, 0xFF, 0xFF};
+  log_inputs.push_back({"frame announcing 512 MB", std::string(reinterpret_cast<const char*>(liar), 28) + "IMU" + std::string(100, 'x')});
+  for (const auto& [what, bytes] : log_inputs) {
     cases.push_back({"LCM log (info)", what, [bytes = bytes](const fs::path& d) {
                        spit(d / "in.lcmlog", bytes);
                        return bin("adit") + " info " + (d / "in.lcmlog").string() + "|in.lcmlog";
                      }, {}});
-    const bool damaged_but_readable = what == "truncated";
+    const bool damaged_but_readable = what == "truncated" || what == "corrupt first frame";
     cases.push_back({"LCM log (replay)", what, [bytes = bytes](const fs::path& d) {
                        spit(d / "in.lcmlog", bytes);
                        return bin("adit") + " replay " + (d / "in.lcmlog").string() + " -o " + (d / "out").string() +
@@ -198,7 +207,10 @@ TEST_F(BadFiles, EveryReaderFailsCleanly) {
   }
   // adit eval on a bad estimate.
   const std::string tum = "0.0 0 0 0 0 0 0 1\n0.1 1 0 0 0 0 0 1\n0.2 2 0 0 0 0 0 1\n";
-  for (const auto& [what, bytes] : generic(tum, good_bin_.substr(0, 3000), 5))
+  auto tum_inputs = generic(tum, good_bin_.substr(0, 3000), 5);
+  tum_inputs.push_back({"NaN position", "0.0 0 0 0 0 0 0 1\n0.1 nan 0 0 0 0 0 1\n"});
+  tum_inputs.push_back({"zero quaternion", "0.0 0 0 0 0 0 0 1\n0.1 1 0 0 0 0 0 0\n"});
+  for (const auto& [what, bytes] : tum_inputs)
     cases.push_back({"trajectory (eval)", what, [bytes = bytes, tum](const fs::path& d) {
                        spit(d / "gt.tum", tum);
                        spit(d / "est.tum", bytes);
@@ -226,6 +238,8 @@ TEST_F(BadFiles, EveryReaderFailsCleanly) {
   const std::string imu = "10.000 0.1 0.2 0.3 0.0 0.0 9.81\n10.005 0.1 0.2 0.3 0.0 0.0 9.81\n";
   auto imu_inputs = generic(imu, good_bin_.substr(0, 3000), 8);
   imu_inputs[1].second = imu.substr(0, 40);  // the second line cut after its time
+  imu_inputs.push_back({"wrong column count", "10.0 1 2 3\n10.1 1 2 3\n"});
+  imu_inputs.push_back({"time beyond 2286", "1e300 0 0 0 0 0 9.8\n"});
   for (const auto& [what, bytes] : imu_inputs)
     cases.push_back({"IMU text (imu-bridge)", what, [bytes = bytes](const fs::path& d) {
                        spit(d / "imu.txt", bytes);
