@@ -82,7 +82,8 @@ TEST_F(Cli, CorruptAndTruncatedLogsAreSkippedOverNotFatal) {
   const fs::path bad = dir_ / "bad.lcmlog";
   std::ofstream(bad, std::ios::binary | std::ios::trunc) << bytes;
   const fs::path out = dir_ / "bad_replay";
-  ASSERT_EQ(run(bin("adit") + " replay " + bad.string() + " -o " + out.string(), dir_ / "bad.txt"), 0) << slurp(dir_ / "bad.txt");
+  // Status 3: the outputs cover the readable part of a damaged log.
+  ASSERT_EQ(run(bin("adit") + " replay " + bad.string() + " -o " + out.string(), dir_ / "bad.txt"), 3) << slurp(dir_ / "bad.txt");
   const std::string report = slurp(dir_ / "bad.txt");
   EXPECT_NE(report.find("truncated"), std::string::npos) << report;
   const auto p = payloads((out / "output.lcmlog").string());
@@ -91,7 +92,7 @@ TEST_F(Cli, CorruptAndTruncatedLogsAreSkippedOverNotFatal) {
   EXPECT_LE(p.at("FEATURES").size(), 9u);
 }
 
-TEST_F(Cli, MissingKittiScanIsCountedAndTheImportGoesOn) {
+TEST_F(Cli, UnreadableKittiScanStopsTheImportUnlessKeepGoing) {
   const fs::path seq = dir_ / "seq_missing";
   fs::create_directories(seq / "velodyne");
   fs::copy_file(kittiSequence("01") + "/times.txt", seq / "times.txt");
@@ -101,7 +102,11 @@ TEST_F(Cli, MissingKittiScanIsCountedAndTheImportGoesOn) {
                   seq / "velodyne" / ("00000" + std::to_string(i) + ".bin"));
   std::ofstream(seq / "velodyne" / "000004.bin", std::ios::binary) << "garbage";
   const fs::path out = dir_ / "missing.lcmlog";
-  ASSERT_EQ(run(bin("adit") + " import kitti " + seq.string() + " -o " + out.string(), dir_ / "missing.txt"), 0)
+  ASSERT_EQ(run(bin("adit") + " import kitti " + seq.string() + " -o " + out.string(), dir_ / "strict.txt"), 1)
+      << slurp(dir_ / "strict.txt");
+  EXPECT_FALSE(fs::exists(out));
+  EXPECT_NE(slurp(dir_ / "strict.txt").find("000004.bin"), std::string::npos);
+  ASSERT_EQ(run(bin("adit") + " import kitti " + seq.string() + " --keep-going -o " + out.string(), dir_ / "missing.txt"), 0)
       << slurp(dir_ / "missing.txt");
   EXPECT_EQ(payloads(out.string()).at("LIDAR_POINTS").size(), 3u);
   EXPECT_NE(slurp(dir_ / "missing.txt").find("000004.bin"), std::string::npos);
