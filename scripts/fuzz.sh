@@ -56,16 +56,18 @@ for h in "${HARNESSES[@]}"; do
   before=$(ls "$findings" | wc -l)
   echo "== $h: ${SECONDS_EACH} s" >&2
   set +e
+  started=$(date +%s)
   nice -n 19 "$BUILD/bin/fuzz_$h" "$corpus" -max_total_time="$SECONDS_EACH" -max_len="${MAX_LEN[$h]:-4096}" \
     -timeout=10 -rss_limit_mb=2048 -malloc_limit_mb=1024 -print_final_stats=1 -artifact_prefix="$findings/" \
     >"$log" 2>&1
   rc=$?
+  elapsed=$(( $(date +%s) - started ))
   set -e
   execs=$(grep -o 'stat::number_of_executed_units: [0-9]*' "$log" | grep -o '[0-9]*$' | tail -1)
   cov=$(grep -o 'cov: [0-9]* ft: [0-9]*' "$log" | tail -1)
   found=$(( $(ls "$findings" | wc -l) - before ))
   [[ $rc -ne 0 || $found -ne 0 ]] && status=1
-  summary+=("$(printf '%-14s %6s s  %10s execs  %-20s findings %d%s' "$h" "$SECONDS_EACH" "${execs:-?}" "${cov:-cov: ?}" \
+  summary+=("$(printf '%-14s %6s s  %10s execs  %-20s findings %d%s' "$h" "$elapsed" "${execs:-?}" "${cov:-cov: ?}" \
     "$found" "$([[ $rc -ne 0 ]] && echo "  (exit $rc, see $log)")")")
 done
 printf '%s\n' "${summary[@]}"
