@@ -29,10 +29,9 @@ class OdometryNode : public runtime::Node {
 
  protected:
   void onTimeJump(const std::string& port) override {
-    if (port == "features") {
-      odometry_.reset();
-      previous_.reset();
-    }
+    // A gap in the sweeps: the trajectory continues across it (the mapper follows the odometry; a reset to
+    // the identity would jump the whole distance travelled).
+    if (port == "features") odometry_.bridgeGap();
     if (port == "imu") imu_.clear();
   }
 

@@ -95,6 +95,11 @@ class ScanToScanOdometry {
 
   const Eigen::Isometry3d& pose() const { return pose_; }
   void reset();
+  // After a gap in the sweeps (a stalled sensor): keep the pose and the previous sweep, and predict the next
+  // sweep's motion by carrying the averaged velocity across the gap (dead reckoning, as a robot that kept
+  // driving); registration against the previous sweep then corrects it. Without this the trajectory would
+  // restart at the identity (a jump of the whole distance travelled) or stand still over the gap.
+  void bridgeGap();
 
  private:
   struct SweepPoints {
@@ -124,6 +129,7 @@ class ScanToScanOdometry {
   Eigen::Isometry3d pose_ = Eigen::Isometry3d::Identity();        // T_odom_lidar of the previous sweep
   Eigen::Isometry3d last_motion_ = Eigen::Isometry3d::Identity();  // T_prev_curr of the previous step
   std::int64_t last_gap_us_ = 0;                                   // 0: no velocity estimate yet
+  bool bridging_ = false;  // the next sweep follows a gap: extrapolate the held velocity across it
   Vector6d held_velocity_ = Vector6d::Zero();  // averaged tangent velocity (per second), see predictHeldMotion
   void updateHeldVelocity(const Eigen::Isometry3d& T_prev_curr, std::int64_t gap_us);
 };
