@@ -45,6 +45,10 @@ expect_grep "back-off 2 s after the 2nd kill" 'odometry killed by signal Killed:
 expect "recorder files in the series" "${#series[@]}" == 2
 expect "STATUS messages kept in record.lcmlog (before the recorder was killed)" \
   "$("$BIN/fault-facts" "$RUN/record.lcmlog" | awk '$1 == "messages" && $2 ~ /^STATUS_/ { n += $3 } END { print n + 0 }')" ">=" 5
+cat "${series[@]}" > "$WORK/all.lcmlog"  # the series concatenated is one log (README)
+"$BIN/adit" info "$WORK/all.lcmlog" > "$WORK/info.txt"
+expect "STATUS_FEATURE in the concatenated series, by adit info" \
+  "$(awk '$1 == "STATUS_FEATURE" { print $2 }' "$WORK/info.txt")" == "$(fact "$WORK/facts.txt" messages STATUS_FEATURE)"
 expect "feature process restarts" "$(fact "$WORK/facts.txt" restarted STATUS_FEATURE)" == 0
 expect "simulator restarts" "$(fact "$WORK/facts.txt" restarted STATUS_SIM)" == 0
 expect "longest silence of STATUS_FEATURE (s; includes the recorder's own 1 s restart)" \

@@ -29,8 +29,12 @@ run() {
   mapfile -t series < <(record_series "$(run_dir "$WORK/$name")")
   mkdir -p "$WORK/$name.tum"
   "$BIN/fault-facts" --out "$WORK/$name.tum" "${series[@]}" > "$WORK/$name.facts"
-  "$BIN/adit" eval --gt "$WORK/$name.tum/truth.tum" --est "$WORK/$name.tum/mapped.tum" --align se3 > "$WORK/$name.eval"
-  awk '/all poses/ { for (i = 1; i <= NF; ++i) if ($i == "rmse") print $(i + 1) }' "$WORK/$name.eval" > "$WORK/$name.ape"
+  if "$BIN/adit" eval --gt "$WORK/$name.tum/truth.tum" --est "$WORK/$name.tum/mapped.tum" --align se3 > "$WORK/$name.eval" 2>&1; then
+    awk '/all poses/ { for (i = 1; i <= NF; ++i) if ($i == "rmse") print $(i + 1) }' "$WORK/$name.eval" > "$WORK/$name.ape"
+  else
+    echo "no trajectory: $(tail -1 "$WORK/$name.eval")"
+    echo none > "$WORK/$name.ape"  # fails the APE check below
+  fi
   grep -E '^(outputs|drops|restarted|status_gap_s) |lost_input' "$WORK/$name.facts" | tr '\n' ';'; echo
 }
 
