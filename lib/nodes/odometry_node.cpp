@@ -29,9 +29,9 @@ class OdometryNode : public runtime::Node {
 
  protected:
   void onTimeJump(const std::string& port) override {
-    // A gap in the sweeps: the trajectory continues across it (the mapper follows the odometry; a reset to
-    // the identity would jump the whole distance travelled).
-    if (port == "features") odometry_.bridgeGap();
+    // A gap in the sweeps (stalled sensor) resets nothing: the odometry carries its averaged velocity across
+    // it and registers against the last sweep (resetting to the identity made the mapper jump back by the
+    // whole distance travelled).
     if (port == "imu") imu_.clear();
   }
 

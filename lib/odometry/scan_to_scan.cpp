@@ -61,17 +61,16 @@ ScanToScanOdometry::ScanToScanOdometry(ScanToScanConfig config) : config_(std::m
 
 void ScanToScanOdometry::reset() { *this = ScanToScanOdometry(config_); }
 
-void ScanToScanOdometry::bridgeGap() { bridging_ = has_previous_ && last_gap_us_ > 0; }
 
 bool ScanToScanOdometry::hasVelocity(std::int64_t utime) const {
   const std::int64_t gap = utime - previous_utime_;
-  return has_previous_ && last_gap_us_ > 0 && gap > 0 && (bridging_ || toSeconds(gap) <= config_.max_velocity_gap_s);
+  return has_previous_ && last_gap_us_ > 0 && gap > 0;
 }
 
 Eigen::Isometry3d ScanToScanOdometry::predictMotion(std::int64_t utime) const {
   const std::int64_t gap = utime - previous_utime_;
   if (!hasVelocity(utime)) return Eigen::Isometry3d::Identity();
-  if (bridging_) return predictHeldMotion(utime);  // one sweep's motion scaled over a long gap amplifies its noise
+  if (toSeconds(gap) > config_.max_velocity_gap_s) return predictHeldMotion(utime);
   return scaleMotion(last_motion_, static_cast<double>(gap) / static_cast<double>(last_gap_us_));
 }
 
@@ -264,7 +263,6 @@ PoseEstimate ScanToScanOdometry::process(const FeatureSet& f, const std::optiona
   previous_raw_ = cur_raw && !mixed;
   has_previous_ = true;
   previous_utime_ = f.utime;
-  bridging_ = false;
   return out;
 }
 

@@ -49,7 +49,9 @@ struct ScanToScanConfig {
   // prior for the first sweeps), move the raw one's points to its end instant with the estimated motion
   // (motion_compensation.hpp). Without this, KITTI's first deskewed pair errs by ~0.6 m.
   bool compensate_mixed_deskew = true;
-  // Longest gap between sweeps (s) over which the constant-velocity model extrapolates; beyond, no motion.
+  // Longest gap between sweeps (s) over which the last motion is extrapolated; across a longer gap (lost
+  // sweeps, a stalled sensor) the averaged velocity is (hold_velocity_time_constant_s): one sweep's motion
+  // scaled over many sweeps would amplify its noise, and no motion at all would lose track of a moving robot.
   double max_velocity_gap_s = 0.5;
   // Time constant (s) of the velocity that degenerate directions are held to: an exponential average of the
   // estimated motions rather than the last one. Where the roadway axis is barely observed (just before it is
@@ -95,11 +97,7 @@ class ScanToScanOdometry {
 
   const Eigen::Isometry3d& pose() const { return pose_; }
   void reset();
-  // After a gap in the sweeps (a stalled sensor): keep the pose and the previous sweep, and predict the next
-  // sweep's motion by carrying the averaged velocity across the gap (dead reckoning, as a robot that kept
-  // driving); registration against the previous sweep then corrects it. Without this the trajectory would
-  // restart at the identity (a jump of the whole distance travelled) or stand still over the gap.
-  void bridgeGap();
+
 
  private:
   struct SweepPoints {
@@ -129,7 +127,6 @@ class ScanToScanOdometry {
   Eigen::Isometry3d pose_ = Eigen::Isometry3d::Identity();        // T_odom_lidar of the previous sweep
   Eigen::Isometry3d last_motion_ = Eigen::Isometry3d::Identity();  // T_prev_curr of the previous step
   std::int64_t last_gap_us_ = 0;                                   // 0: no velocity estimate yet
-  bool bridging_ = false;  // the next sweep follows a gap: extrapolate the held velocity across it
   Vector6d held_velocity_ = Vector6d::Zero();  // averaged tangent velocity (per second), see predictHeldMotion
   void updateHeldVelocity(const Eigen::Isometry3d& T_prev_curr, std::int64_t gap_us);
 };

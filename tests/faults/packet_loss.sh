@@ -22,7 +22,7 @@ echo "tc netem: $netem; packet loss by nftables (numgen random) on incoming mult
 # run NAME: one simulated live run; facts in $WORK/NAME.facts, APE rmse in $WORK/NAME.ape
 run() {
   local name=$1 out=$WORK/$1.launch.out
-  start_launch "$out" "$ROOT/launch/sim.launch.yaml" --set WORLD="$WORLD" --set DURATION="$DURATION" \
+  start_launch "$out" "${LAUNCH_FILE:-$ROOT/launch/sim.launch.yaml}" --set WORLD="$WORLD" --set DURATION="$DURATION" \
     --set 'RECORD=^(ODOM_MAPPED|GROUND_TRUTH|STATUS_.*)$' --log-dir "$WORK/$name" --quiet
   wait_launch
   echo "$name: adit launch exit code $LAUNCH_RC; $(tail -1 "$out")"
