@@ -49,9 +49,22 @@ Restart parseRestart(const std::string& s, const std::string& where) {
   throw std::runtime_error(where + ": restart must be never, on-failure or always, not '" + s + "'");
 }
 
+// max_restarts and restart_window_s of `node` over `base`, checked.
+RestartLimits readLimits(const YAML::Node& node, RestartLimits base, const std::string& where) {
+  if (node["max_restarts"]) base.max_restarts = node["max_restarts"].as<int>();
+  if (node["restart_window_s"]) base.window_s = node["restart_window_s"].as<double>();
+  if (base.max_restarts < 0)
+    throw std::runtime_error(where + ": max_restarts must be >= 0, not " + std::to_string(base.max_restarts));
+  if (!(base.window_s > 0))
+    throw std::runtime_error(where + ": restart_window_s must be > 0, not " + std::to_string(base.window_s));
+  return base;
+}
+
 }  // namespace
 
-LaunchSpec loadLaunchFile(const std::string& path, const std::map<std::string, std::string>& vars) {
+namespace {
+
+LaunchSpec readLaunchFile(const std::string& path, const std::map<std::string, std::string>& vars) {
   YAML::Node root;
   try {
     root = YAML::LoadFile(path);
@@ -64,6 +77,10 @@ LaunchSpec loadLaunchFile(const std::string& path, const std::map<std::string, s
   spec.lcm_url = root["lcm_url"] ? sub(root["lcm_url"], "lcm_url") : "";
   if (root["record"]) spec.record_channels = sub(root["record"], "record");
   if (root["grace_s"]) spec.grace_s = root["grace_s"].as<double>();
+  spec.limits = readLimits(root, spec.limits, path);
+  spec.recorder_limits = spec.limits;
+  spec.recorder_limits.max_restarts = root["record_max_restarts"] ? root["record_max_restarts"].as<int>() : 3;
+  if (spec.recorder_limits.max_restarts < 0) throw std::runtime_error(path + ": record_max_restarts must be >= 0");
   if (root["stop_when_exit"])
     for (const auto& n : root["stop_when_exit"]) spec.stop_when_exit.push_back(n.as<std::string>());
   if (!root["processes"] || !root["processes"].IsSequence() || root["processes"].size() == 0)
@@ -76,6 +93,7 @@ LaunchSpec loadLaunchFile(const std::string& path, const std::map<std::string, s
     for (const auto& arg : p["command"]) proc.command.push_back(sub(arg, proc.name + ".command"));
     if (p["delay_s"]) proc.delay_s = p["delay_s"].as<double>();
     if (p["restart"]) proc.restart = parseRestart(p["restart"].as<std::string>(), path + ": " + proc.name);
+    proc.limits = readLimits(p, spec.limits, path + ": " + proc.name);
     spec.processes.push_back(std::move(proc));
   }
   for (const auto& name : spec.stop_when_exit) {
@@ -84,6 +102,16 @@ LaunchSpec loadLaunchFile(const std::string& path, const std::map<std::string, s
     if (!known) throw std::runtime_error("launch file '" + path + "': stop_when_exit names unknown process '" + name + "'");
   }
   return spec;
+}
+
+}  // namespace
+
+LaunchSpec loadLaunchFile(const std::string& path, const std::map<std::string, std::string>& vars) {
+  try {
+    return readLaunchFile(path, vars);
+  } catch (const YAML::Exception& e) {  // a value of the wrong type: name the file, not just the line
+    throw std::runtime_error("launch file '" + path + "': " + e.what());
+  }
 }
 
 }  // namespace adit::launch

@@ -1,6 +1,9 @@
 // Launch files (launch/*.launch.yaml): which processes to start, with which LCM URL and configuration,
-// what to record, and when the run ends. See launch/README.md for the format.
+// what to record, when the run ends and how often a crashing process is restarted. The format is documented
+// in README.md ("Running the processes").
 #pragma once
+
+#include "launch/restart_policy.hpp"
 
 #include <map>
 #include <string>
@@ -15,6 +18,8 @@ struct ProcessSpec {
   std::vector<std::string> command;  // argv; "adit-*" and "adit" resolve to the build's bin/ first
   Restart restart = Restart::OnFailure;
   double delay_s = 0.0;  // wait this long before the first start (let subscribers come up first)
+  // max_restarts / restart_window_s: the file's top-level values unless the process sets its own.
+  RestartLimits limits;
 };
 
 struct LaunchSpec {
@@ -24,6 +29,8 @@ struct LaunchSpec {
   std::string record_channels;           // regex for lcm-logger; "" = record nothing
   std::vector<std::string> stop_when_exit;  // the run ends when any of these exits by itself
   double grace_s = 2.0;                  // after such an exit, let the rest drain before stopping
+  RestartLimits limits;                  // top-level max_restarts (5) and restart_window_s (60)
+  RestartLimits recorder_limits;         // the recorder's: record_max_restarts (3), same window
 };
 
 // Reads a launch file, substituting ${VAR} (or ${VAR:-default}) from `vars` first, then the environment. Throws

@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 #include <poll.h>
 #include <signal.h>
+#include <sys/statvfs.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -33,7 +34,9 @@ struct Child {
   int fd = -1;  // read end of the child's stdout+stderr
   std::string partial;
   std::ofstream log;
-  double backoff_s = 1.0;
+  RestartPolicy policy;
+  int restarts = 0;  // starts after the first (ADIT_RESTART_COUNT)
+  bool recorder = false;  // its last argument is replaced by the next free record*.lcmlog on each start
   Clock::time_point started, next_start;
   bool finished = false;  // exited and will not be restarted
 };
@@ -52,6 +55,7 @@ std::string resolve(const std::string& program, const std::string& bin_dir) {
 }
 
 bool start(Child& c, const LaunchSpec& spec, const SupervisorOptions& options) {
+  if (c.recorder) c.spec.command.back() = nextRecordPath(options.run_dir);
   int fds[2];
   if (::pipe(fds) != 0) return false;
   const pid_t pid = ::fork();
@@ -63,6 +67,9 @@ bool start(Child& c, const LaunchSpec& spec, const SupervisorOptions& options) {
     ::close(fds[0]);
     ::close(fds[1]);
     if (!spec.lcm_url.empty()) ::setenv("LCM_DEFAULT_URL", spec.lcm_url.c_str(), 1);
+    ::setenv("ADIT_RUN_DIR", options.run_dir.c_str(), 1);
+    ::setenv("ADIT_PROCESS_NAME", c.spec.name.c_str(), 1);
+    ::setenv("ADIT_RESTART_COUNT", std::to_string(c.restarts).c_str(), 1);
     // adit's own programs first, also for commands run through a shell.
     const char* path = std::getenv("PATH");
     ::setenv("PATH", (options.bin_dir + ":" + (path ? path : "/usr/bin:/bin")).c_str(), 1);
@@ -80,7 +87,9 @@ bool start(Child& c, const LaunchSpec& spec, const SupervisorOptions& options) {
   c.pid = pid;
   c.fd = fds[0];
   c.started = Clock::now();
-  say("started " + c.spec.name + " (pid " + std::to_string(pid) + ")");
+  say(fmt::format("started {} (pid {}{}{})", c.spec.name, pid,
+                  c.restarts > 0 ? fmt::format(", restart {}", c.restarts) : "",
+                  c.recorder ? ", writing " + fs::path(c.spec.command.back()).filename().string() : ""));
   return true;
 }
 
@@ -119,6 +128,16 @@ std::string describe(int status) {
   return "stopped";
 }
 
+// Free space of the run folder's file system, for the message when the recorder ends (a full disk is the
+// usual reason it cannot go on).
+std::string diskNote(const std::string& dir) {
+  struct statvfs st {};
+  if (::statvfs(dir.c_str(), &st) != 0) return "";
+  const double free_mb = static_cast<double>(st.f_bavail) * static_cast<double>(st.f_frsize) / 1e6;
+  return free_mb < 1.0 ? fmt::format(" (the run folder's disk is full: {:.2f} MB free)", free_mb)
+                       : fmt::format(" ({:.0f} MB free in the run folder)", free_mb);
+}
+
 bool wantsRestart(const Child& c, int status) {
   const bool clean = WIFEXITED(status) && WEXITSTATUS(status) == 0;
   switch (c.spec.restart) {
@@ -155,18 +174,73 @@ void stopAll(std::vector<Child>& children, const SupervisorOptions& options) {
 
 }  // namespace
 
+std::string nextRecordPath(const std::string& run_dir) {
+  for (int i = 0;; ++i) {
+    const fs::path p = fs::path(run_dir) / (i == 0 ? std::string("record.lcmlog") : fmt::format("record.{}.lcmlog", i));
+    std::error_code ec;
+    if (!fs::exists(p, ec)) return p.string();
+  }
+}
+
+namespace {
+
+bool isStopWhenExit(const LaunchSpec& spec, const std::string& name) {
+  return std::find(spec.stop_when_exit.begin(), spec.stop_when_exit.end(), name) != spec.stop_when_exit.end();
+}
+
+bool cleanExit(int status) { return WIFEXITED(status) && WEXITSTATUS(status) == 0; }
+
+// Decides what follows the exit of `c`; returns a failure of the run to report at the end, or "".
+std::string onExit(Child& c, int status, const LaunchSpec& spec, const SupervisorOptions& options,
+                   std::optional<Clock::time_point>& stop_at, Clock::time_point run_start) {
+  const auto now = Clock::now();
+  const double ran_s = std::chrono::duration<double>(now - c.started).count();
+  const std::string how = describe(status) + (c.recorder ? diskNote(options.run_dir) : "");
+  if (isStopWhenExit(spec, c.spec.name)) {
+    say(fmt::format("{} {}: ending the run in {:g} s", c.spec.name, how, spec.grace_s));
+    c.finished = true;
+    const auto end = now + seconds(spec.grace_s);
+    if (!stop_at || end < *stop_at) stop_at = end;
+    return cleanExit(status) ? "" : fmt::format("{} {}, which ends the run", c.spec.name, how);
+  }
+  if (!wantsRestart(c, status)) {
+    say(c.spec.name + " " + how + ": not restarting");
+    c.finished = true;
+    return cleanExit(status) ? "" : fmt::format("{} {} (restart: never)", c.spec.name, how);
+  }
+  const auto delay = c.policy.onExit(std::chrono::duration<double>(now - run_start).count(), ran_s);
+  if (!delay) {
+    const auto& l = c.policy.limits();
+    const std::string why = fmt::format("{} gave up: {} exits within {:g} s (max_restarts {}), the last one {}",
+                                        c.spec.name, c.policy.exitsInWindow(), l.window_s, l.max_restarts, how);
+    say(why + "; the other processes keep running");
+    c.finished = true;
+    return why;
+  }
+  say(fmt::format("{} {}: restarting in {:g} s ({} of at most {} exits within {:g} s)", c.spec.name, how, *delay,
+                  c.policy.exitsInWindow(), c.policy.limits().max_restarts, c.policy.limits().window_s));
+  c.next_start = now + seconds(*delay);
+  ++c.restarts;
+  return "";
+}
+
+}  // namespace
+
 int supervise(const LaunchSpec& spec, const SupervisorOptions& options) {
   fs::create_directories(options.run_dir);
   std::vector<Child> children;
   if (!spec.record_channels.empty()) {
     Child rec;
-    rec.spec = {"recorder", {"lcm-logger", "-q", "-f", "-c", spec.record_channels, (fs::path(options.run_dir) / "record.lcmlog").string()},
-                Restart::OnFailure};
+    // -f is never given: the path is always new (nextRecordPath), and lcm-logger refuses to overwrite.
+    rec.spec = {"recorder", {"lcm-logger", "-q", "-c", spec.record_channels, "record.lcmlog"}, Restart::OnFailure};
+    rec.policy = RestartPolicy(spec.recorder_limits);
+    rec.recorder = true;
     children.push_back(std::move(rec));
   }
   for (const auto& p : spec.processes) {
     Child c;
     c.spec = p;
+    c.policy = RestartPolicy(p.limits);
     children.push_back(std::move(c));
   }
   runtime::installStopHandlers();
@@ -176,14 +250,15 @@ int supervise(const LaunchSpec& spec, const SupervisorOptions& options) {
     if (!start(c, spec, options)) {
       say("cannot start " + c.spec.name + ": " + std::strerror(errno));
       stopAll(children, options);
-      return 1;
+      return kRunCannotStart;
     }
-    if (c.spec.name == "recorder") std::this_thread::sleep_for(std::chrono::milliseconds(300));  // subscribed before data flows
+    if (c.recorder) std::this_thread::sleep_for(std::chrono::milliseconds(300));  // subscribed before data flows
   }
 
   const auto run_start = Clock::now();
   std::optional<Clock::time_point> stop_at;
   if (options.duration_s > 0) stop_at = run_start + seconds(options.duration_s);
+  std::vector<std::string> failures;
   while (!runtime::stopRequested() && !(stop_at && Clock::now() >= *stop_at)) {
     std::vector<pollfd> pfds;
     for (auto& c : children)
@@ -196,31 +271,23 @@ int supervise(const LaunchSpec& spec, const SupervisorOptions& options) {
     while ((pid = ::waitpid(-1, &status, WNOHANG)) > 0) {
       auto it = std::find_if(children.begin(), children.end(), [pid](const Child& c) { return c.pid == pid; });
       if (it == children.end()) continue;
-      Child& c = *it;
-      drain(c, options.echo);
-      c.pid = -1;
-      const double ran_s = std::chrono::duration<double>(Clock::now() - c.started).count();
-      if (std::find(spec.stop_when_exit.begin(), spec.stop_when_exit.end(), c.spec.name) != spec.stop_when_exit.end()) {
-        say(fmt::format("{} {}: ending the run in {:g} s", c.spec.name, describe(status), spec.grace_s));
-        c.finished = true;
-        const auto end = Clock::now() + seconds(spec.grace_s);
-        if (!stop_at || end < *stop_at) stop_at = end;
-      } else if (wantsRestart(c, status)) {
-        if (ran_s > 30.0) c.backoff_s = 1.0;  // it had been healthy: start the back-off afresh
-        say(fmt::format("{} {}: restarting in {:g} s", c.spec.name, describe(status), c.backoff_s));
-        c.next_start = Clock::now() + seconds(c.backoff_s);
-        c.backoff_s = std::min(30.0, c.backoff_s * 2.0);
-      } else {
-        say(c.spec.name + " " + describe(status) + ": not restarting");
-        c.finished = true;
-      }
+      drain(*it, options.echo);
+      it->pid = -1;
+      if (auto failure = onExit(*it, status, spec, options, stop_at, run_start); !failure.empty())
+        failures.push_back(std::move(failure));
     }
     for (auto& c : children)
       if (c.pid < 0 && !c.finished && Clock::now() >= c.next_start && c.fd < 0) start(c, spec, options);
   }
   say(runtime::stopRequested() ? "interrupted: stopping" : "run complete: stopping");
   stopAll(children, options);
-  return 0;
+  if (failures.empty()) {
+    say("run ended as planned");
+    return kRunOk;
+  }
+  for (std::size_t i = 0; i + 1 < failures.size(); ++i) say("failed: " + failures[i]);
+  say(fmt::format("run failed ({} problem{}): {}", failures.size(), failures.size() > 1 ? "s" : "", failures.back()));
+  return kRunFailed;
 }
 
 }  // namespace adit::launch

@@ -29,10 +29,9 @@ class OdometryNode : public runtime::Node {
 
  protected:
   void onTimeJump(const std::string& port) override {
-    if (port == "features") {
-      odometry_.reset();
-      previous_.reset();
-    }
+    // A gap in the sweeps (stalled sensor) resets nothing: the odometry carries its averaged velocity across
+    // it and registers against the last sweep (resetting to the identity made the mapper jump back by the
+    // whole distance travelled).
     if (port == "imu") imu_.clear();
   }
 

@@ -61,14 +61,16 @@ ScanToScanOdometry::ScanToScanOdometry(ScanToScanConfig config) : config_(std::m
 
 void ScanToScanOdometry::reset() { *this = ScanToScanOdometry(config_); }
 
+
 bool ScanToScanOdometry::hasVelocity(std::int64_t utime) const {
   const std::int64_t gap = utime - previous_utime_;
-  return has_previous_ && last_gap_us_ > 0 && gap > 0 && toSeconds(gap) <= config_.max_velocity_gap_s;
+  return has_previous_ && last_gap_us_ > 0 && gap > 0;
 }
 
 Eigen::Isometry3d ScanToScanOdometry::predictMotion(std::int64_t utime) const {
   const std::int64_t gap = utime - previous_utime_;
   if (!hasVelocity(utime)) return Eigen::Isometry3d::Identity();
+  if (toSeconds(gap) > config_.max_velocity_gap_s) return predictHeldMotion(utime);
   return scaleMotion(last_motion_, static_cast<double>(gap) / static_cast<double>(last_gap_us_));
 }
 

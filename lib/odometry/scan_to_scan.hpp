@@ -49,7 +49,9 @@ struct ScanToScanConfig {
   // prior for the first sweeps), move the raw one's points to its end instant with the estimated motion
   // (motion_compensation.hpp). Without this, KITTI's first deskewed pair errs by ~0.6 m.
   bool compensate_mixed_deskew = true;
-  // Longest gap between sweeps (s) over which the constant-velocity model extrapolates; beyond, no motion.
+  // Longest gap between sweeps (s) over which the last motion is extrapolated; across a longer gap (lost
+  // sweeps, a stalled sensor) the averaged velocity is (hold_velocity_time_constant_s): one sweep's motion
+  // scaled over many sweeps would amplify its noise, and no motion at all would lose track of a moving robot.
   double max_velocity_gap_s = 0.5;
   // Time constant (s) of the velocity that degenerate directions are held to: an exponential average of the
   // estimated motions rather than the last one. Where the roadway axis is barely observed (just before it is
@@ -95,6 +97,7 @@ class ScanToScanOdometry {
 
   const Eigen::Isometry3d& pose() const { return pose_; }
   void reset();
+
 
  private:
   struct SweepPoints {

@@ -5,12 +5,12 @@
 
 namespace adit::sources {
 
-SimSource::SimSource(const sim::SimConfig& config, SimChannels channels)
-    : simulator_(config), channels_(std::move(channels)) {}
+SimSource::SimSource(const sim::SimConfig& config, SimChannels channels, SimStalls stalls)
+    : simulator_(config), channels_(std::move(channels)), stalls_(stalls) {}
 
 double SimSource::progress() const {
   const auto total = simulator_.numSweeps();
-  return total > 0 ? static_cast<double>(truth_.size()) / static_cast<double>(total) : 1.0;
+  return total > 0 ? static_cast<double>(sweeps_) / static_cast<double>(total) : 1.0;
 }
 
 bool SimSource::next(runtime::OutgoingMessage& out) {
@@ -21,7 +21,16 @@ bool SimSource::next(runtime::OutgoingMessage& out) {
     return true;
   }
   sim::SimEvent event;
-  if (!simulator_.next(event)) return false;
+  for (;;) {  // skip what a stalled stream would not have published
+    if (!simulator_.next(event)) return false;
+    const bool scan = event.kind == sim::SimEvent::Kind::Scan;
+    const std::int64_t utime = scan ? event.scan.utime : event.imu.utime;
+    if (first_utime_ < 0) first_utime_ = utime;
+    if (scan) ++sweeps_;
+    const double t_s = static_cast<double>(utime - first_utime_) * 1e-6;
+    if (!(scan ? stalls_.lidar : stalls_.imu).covers(t_s)) break;
+    if (!scan) ++imu_seq_;
+  }
   if (event.kind == sim::SimEvent::Kind::Scan) {
     adit::point_cloud_t m = msg::toMessage(event.scan);
     out = {channels_.lidar, msg::encode(m), event.scan.utime};

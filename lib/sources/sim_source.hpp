@@ -16,20 +16,33 @@ struct SimChannels {
   std::string ground_truth = "GROUND_TRUTH";  // "" = do not publish
 };
 
+// Sensor outages for fault tests: a stream publishes nothing from start_s (seconds of sensor time after the
+// first message) for duration_s, then resumes (its sequence numbers show the gap, as a real driver's would).
+struct SimStall {
+  double start_s = 0, duration_s = 0;  // duration 0 = no stall
+  bool covers(double t_s) const { return duration_s > 0 && t_s >= start_s && t_s < start_s + duration_s; }
+};
+struct SimStalls {
+  SimStall lidar, imu;
+};
+
 class SimSource : public runtime::MessageSource {
  public:
-  SimSource(const sim::SimConfig& config, SimChannels channels);
+  SimSource(const sim::SimConfig& config, SimChannels channels, SimStalls stalls = {});
   bool next(runtime::OutgoingMessage& message) override;
   const runtime::Health& health() const override { return health_; }
   double progress() const override;
 
   const sim::Simulator& simulator() const { return simulator_; }
-  // T_world_lidar at each sweep's utime (its last firing), in the order published.
+  // T_world_lidar at each sweep's utime (its last firing), in the order published (stalled sweeps left out).
   const Trajectory& groundTruth() const { return truth_; }
 
  private:
   sim::Simulator simulator_;
   SimChannels channels_;
+  SimStalls stalls_;
+  std::int64_t first_utime_ = -1;
+  std::size_t sweeps_ = 0;  // simulated, stalled or not (progress)
   runtime::Health health_;
   Trajectory truth_;
   std::optional<runtime::OutgoingMessage> pending_truth_;  // published right after its sweep

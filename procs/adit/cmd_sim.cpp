@@ -17,7 +17,28 @@ struct SimArgs {
   double duration_s = -1, rate = 1.0, world_spacing = 0.1;
   std::int64_t seed = -1;
   bool live = false, no_truth_channel = false;
+  std::string stall_lidar, stall_imu;
 };
+
+// "START:SECONDS" (seconds of sensor time after the first message) -> a stall.
+adit::sources::SimStall parseStall(const std::string& text, const std::string& flag) {
+  adit::sources::SimStall stall;
+  if (text.empty()) return stall;
+  const auto colon = text.find(':');
+  try {
+    if (colon == std::string::npos) throw std::invalid_argument("no colon");
+    std::size_t used = 0;
+    stall.start_s = std::stod(text.substr(0, colon), &used);
+    if (used != colon) throw std::invalid_argument("trailing characters");
+    stall.duration_s = std::stod(text.substr(colon + 1), &used);
+    if (used != text.size() - colon - 1) throw std::invalid_argument("trailing characters");
+  } catch (const std::exception&) {
+    throw CLI::ValidationError(flag, "expects START:SECONDS (e.g. 20:10), got '" + text + "'");
+  }
+  if (!(stall.start_s >= 0) || !(stall.duration_s > 0))
+    throw CLI::ValidationError(flag, "START must be >= 0 and SECONDS > 0, got '" + text + "'");
+  return stall;
+}
 
 }  // namespace
 
@@ -38,6 +59,9 @@ void registerSimCommand(CLI::App& app) {
   cmd->add_option("--rate", a->rate, "With --live: multiple of real time (0 = as fast as possible)")->check(CLI::NonNegativeNumber);
   cmd->add_option("--lcm-url", a->lcm_url, "With --live: LCM provider (default: $LCM_DEFAULT_URL or udpm)");
   cmd->add_flag("--no-ground-truth-channel", a->no_truth_channel, "Do not publish GROUND_TRUTH");
+  cmd->add_option("--stall-lidar", a->stall_lidar,
+                  "Fault test: publish no LIDAR_POINTS (nor their GROUND_TRUTH) from START for SECONDS of sensor time (START:SECONDS)");
+  cmd->add_option("--stall-imu", a->stall_imu, "Fault test: publish no IMU from START for SECONDS (START:SECONDS)");
   cmd->callback([a] {
     if (a->live == !a->output.empty()) throw CLI::ValidationError("adit sim", "give either -o LOG or --live");
     adit::sim::SimConfig config = adit::sim::simConfigFrom(adit::runtime::loadConfig(a->configs));
@@ -48,7 +72,8 @@ void registerSimCommand(CLI::App& app) {
 
     adit::sources::SimChannels channels;
     if (a->no_truth_channel) channels.ground_truth.clear();
-    adit::sources::SimSource source(config, channels);
+    const adit::sources::SimStalls stalls{parseStall(a->stall_lidar, "--stall-lidar"), parseStall(a->stall_imu, "--stall-imu")};
+    adit::sources::SimSource source(config, channels, stalls);
     fmt::print("sim: world {} ({:.0f} m route), sensor {}, {:.0f} s, seed {}: {} sweeps\n", config.world,
                source.simulator().lapLength(), config.sensor, config.duration_s, config.seed,
                source.simulator().numSweeps());

@@ -5,11 +5,8 @@
 #   launch_udp.sh <bin_dir> <shared_data_dir>
 set -euo pipefail
 BIN=$1 DATA=$2
-if [ -z "${ADIT_IN_NETNS:-}" ]; then
-  exec unshare -rn env ADIT_IN_NETNS=1 bash "$0" "$@"
-fi
-ip link set lo up multicast on
-ip route add 224.0.0.0/4 dev lo
+# Inside a private network namespace (netns.sh: exit 77 = skipped, with the reason, where none can be made).
+[ -n "${ADIT_IN_NETNS:-}" ] || exec bash "$(dirname "$0")/netns.sh" bash "$0" "$@"
 
 WORK=$(mktemp -d)
 trap 'rm -rf "$WORK"' EXIT

@@ -1,0 +1,76 @@
+# Shared by the fault tests (source it: `source "$(dirname "$0")/common.sh" "$@"`; arguments BIN_DIR ROOT).
+# Re-runs the calling script inside a private network namespace (netns.sh; exit 77 = skipped with the reason),
+# makes a work folder, and offers: launch runs in the background, waiting for a launcher line, facts from the
+# recorded logs (fault-facts) and assertions that print what they measured.
+set -euo pipefail
+BIN=$1 ROOT=$2
+FAULTS=$ROOT/tests/faults
+if [ -z "${ADIT_IN_NETNS:-}" ]; then
+  exec bash "$ROOT/tests/integration/netns.sh" ${NETNS_FLAGS:-} bash "$0" "$@"
+fi
+WORK=$(mktemp -d)
+LAUNCH_PID=
+cleanup() {
+  if [ -n "$LAUNCH_PID" ] && kill -0 "$LAUNCH_PID" 2>/dev/null; then kill -INT "$LAUNCH_PID"; wait "$LAUNCH_PID" || true; fi
+  if [ -n "${KEEP_WORK:-}" ]; then echo "work folder kept: $WORK"; else rm -rf "$WORK"; fi
+}
+trap cleanup EXIT
+failed=0
+
+# start_launch OUT LAUNCH_FILE [adit launch options...]: in the background; LAUNCH_PID, output in OUT.
+start_launch() {
+  local out=$1; shift
+  "$BIN/adit" launch "$@" > "$out" 2>&1 &
+  LAUNCH_PID=$!
+}
+
+# wait_launch: waits for the launcher to end; its exit code in LAUNCH_RC (not in a $(...): a subshell cannot
+# wait for its parent's child).
+wait_launch() {
+  LAUNCH_RC=0
+  wait "$LAUNCH_PID" || LAUNCH_RC=$?
+  LAUNCH_PID=
+}
+
+# wait_line OUT REGEX SECONDS: prints the first launcher line matching REGEX; fails after SECONDS.
+wait_line() {
+  local deadline=$((SECONDS + $3)) line
+  while [ $SECONDS -lt $deadline ]; do
+    if line=$(grep -E -m1 "$2" "$1"); then echo "$line"; return 0; fi
+    sleep 0.2
+  done
+  echo "FAIL: no line matching '$2' within $3 s" >&2
+  tail -20 "$1" >&2
+  return 1
+}
+
+# fact FACTS KEY FIELDS...: the value of the line `KEY FIELDS... VALUE` of a fault-facts output (0 if absent).
+fact() {
+  local file=$1; shift
+  awk -v key="$*" '{ v = $NF; $NF = ""; sub(/ +$/, ""); if ($0 == key) { found = v } } END { print (found == "" ? 0 : found) }' "$file"
+}
+
+# expect WHAT VALUE OP LIMIT (OP one of < <= > >= ==): prints ok/FAIL with the value.
+expect() {
+  if awk -v v="$2" -v l="$4" -v op="$3" 'BEGIN { exit !((op == "<" && v < l) || (op == "<=" && v <= l) || (op == ">" && v > l) || (op == ">=" && v >= l) || (op == "==" && v == l)) }'; then
+    echo "ok: $1 = $2 ($3 $4)"
+  else
+    echo "FAIL: $1 = $2, expected $3 $4"
+    failed=1
+  fi
+}
+
+# expect_grep WHAT REGEX FILE
+expect_grep() {
+  if grep -qE "$2" "$3"; then echo "ok: $1"; else echo "FAIL: $1 (no line matching '$2' in $(basename "$3"))"; failed=1; fi
+}
+
+# The run folder a launch made under $WORK/logs (or $1).
+run_dir() { ls -d "${1:-$WORK/logs}"/*-*/ | head -1; }
+
+# The recorder's series of a run folder, in order (record.lcmlog, record.1.lcmlog, ...).
+record_series() {
+  local dir=$1 i=1
+  echo "$dir/record.lcmlog"
+  while [ -f "$dir/record.$i.lcmlog" ]; do echo "$dir/record.$i.lcmlog"; i=$((i + 1)); done
+}
