@@ -19,6 +19,7 @@
 #include "loop/scan_context_database.hpp"
 
 #include <optional>
+#include <string>
 #include <vector>
 
 namespace adit {
@@ -123,6 +124,12 @@ class LoopCloser {
   const LoopCloserStats& stats() const { return stats_; }
   const LoopCloserConfig& config() const { return config_; }
   Eigen::Isometry3d correction(int keyframe) const;  // X_k * U_k^-1
+
+  // The whole state (keyframes with clouds and Scan Contexts, odometry chain, graph, loops, counters) as
+  // bytes for a checkpoint (loop_closer_state.cpp), and back. restoreState() leaves this object unchanged
+  // and returns false if the bytes are malformed.
+  std::string saveState() const;
+  bool restoreState(const std::string& bytes);
 
  private:
   bool isKeyframe(const Eigen::Isometry3d& pose) const;

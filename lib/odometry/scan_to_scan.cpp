@@ -61,6 +61,11 @@ ScanToScanOdometry::ScanToScanOdometry(ScanToScanConfig config) : config_(std::m
 
 void ScanToScanOdometry::reset() { *this = ScanToScanOdometry(config_); }
 
+void ScanToScanOdometry::resumeAt(const Eigen::Isometry3d& pose) {
+  reset();
+  if (pose.matrix().allFinite()) pose_ = pose;
+}
+
 bool ScanToScanOdometry::hasVelocity(std::int64_t utime) const {
   const std::int64_t gap = utime - previous_utime_;
   return has_previous_ && last_gap_us_ > 0 && gap > 0 && toSeconds(gap) <= config_.max_velocity_gap_s;

@@ -94,7 +94,13 @@ class ScanToScanOdometry {
                         const Eigen::Isometry3d& T_prev_curr) const;
 
   const Eigen::Isometry3d& pose() const { return pose_; }
+  // The averaged velocity (tangent, per second) and the time of the last sweep: what a restart extrapolates.
+  const Vector6d& heldVelocity() const { return held_velocity_; }
+  std::int64_t lastUtime() const { return has_previous_ ? previous_utime_ : -1; }
   void reset();
+  // Starts over (no previous sweep, no velocity) but at `pose` instead of the identity: after a restart or a
+  // gap in the input, the odometry frame continues where it was.
+  void resumeAt(const Eigen::Isometry3d& pose);
 
  private:
   struct SweepPoints {

@@ -1,0 +1,59 @@
+// Checkpoint handling shared by the stage nodes: where a node's checkpoint lives in the run folder, resuming
+// from it (refusing a bad one with a clear error and a fresh start), and saving it without ever taking the
+// process down.
+#pragma once
+
+#include "runtime/checkpoint.hpp"
+#include "runtime/run_folder.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include <functional>
+#include <string>
+
+namespace adit::nodes {
+
+class RunState {
+ public:
+  explicit RunState(std::string kind) : kind_(std::move(kind)) {}
+
+  void setFolder(const runtime::RunFolder& folder) { folder_ = folder; }
+  const runtime::RunFolder& folder() const { return folder_; }
+  bool live() const { return folder_.live; }
+  std::string checkpointPath() const { return folder_.file(kind_ + ".ckpt"); }
+
+  // Resumes when the folder allows it and a checkpoint of this run is there: `restore` gets the payload and
+  // returns "" or why it is unusable. Returns true if restored. `error` gets a refusal (already logged).
+  bool resume(const std::function<std::string(const std::string&)>& restore, std::string& error) const {
+    if (!folder_.mayResume()) return false;
+    const runtime::LoadedCheckpoint loaded = runtime::loadCheckpoint(checkpointPath(), kind_, folder_.run_id);
+    if (loaded.status == runtime::LoadedCheckpoint::Status::kMissing) {
+      if (folder_.restart_count > 0)
+        spdlog::warn("[{}] restarted but no checkpoint at {}: starting fresh", kind_, checkpointPath());
+      return false;
+    }
+    error = loaded.error;
+    if (loaded.status == runtime::LoadedCheckpoint::Status::kLoaded) {
+      error = restore(loaded.payload);
+      if (!error.empty()) error = checkpointPath() + ": " + error;
+    }
+    if (!error.empty()) error += ": checkpoint refused, starting fresh";
+    return error.empty();
+  }
+
+  // Returns "" or the error (the previous checkpoint is then intact).
+  std::string save(const std::string& payload) const {
+    try {
+      runtime::saveCheckpoint(checkpointPath(), kind_, folder_.run_id, payload);
+      return "";
+    } catch (const std::exception& e) {
+      return std::string("checkpoint not written: ") + e.what();
+    }
+  }
+
+ private:
+  std::string kind_;
+  runtime::RunFolder folder_;
+};
+
+}  // namespace adit::nodes
