@@ -35,7 +35,7 @@ class LoopCloserNode : public runtime::Node, public WritesProducts {
       : Node("loop_closer"), closer_(loopCloserConfigFrom(config)),
         map_voxel_(config.get<double>("loop.map_voxel", 0.1)),
         // Keyframes between checkpoints (also written after every loop and on stop). 0 = never.
-        checkpoint_keyframes_(config.get<int>("loop.node.checkpoint_keyframes", 20)),
+        checkpoint_keyframes_(config.get<int>("loop.node.checkpoint_keyframes", 10)),
         updates_(mapUpdateConfigFrom(config)), state_("loop_closer") {
     subscribe<adit::odometry_t>("mapped", "ODOM_MAPPED", [this](const adit::odometry_t& m) { onMapped(m); });
     subscribe<adit::command_t>("command", "MAPPER_COMMAND", [this](const adit::command_t& m) { onCommand(m); },
