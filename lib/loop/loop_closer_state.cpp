@@ -56,22 +56,25 @@ std::vector<int*> statFields(LoopCloserStats& s) {
 
 }  // namespace
 
+std::string LoopCloser::keyframeRecord(int k) const {
+  ByteWriter w;
+  const Keyframe& kf = keyframes_[static_cast<std::size_t>(k)];
+  w.put<std::int64_t>(kf.utime);
+  w.putPose(kf.uncorrected);
+  w.putPoints(kf.cloud);
+  const ScanContext& sc = database_.context(k);
+  w.put<std::int32_t>(sc.rings());
+  w.put<std::int32_t>(sc.sectors());
+  w.put<std::int32_t>(sc.shiftSearchRadius());
+  w.putMatrix(sc.descriptor());
+  w.putMatrix(chain_.stepCovariance(k));
+  return w.bytes();
+}
+
 std::string LoopCloser::saveState() const {
   ByteWriter w;
   w.put<std::uint64_t>(keyframes_.size());
-  for (std::size_t k = 0; k < keyframes_.size(); ++k) {
-    const Keyframe& kf = keyframes_[k];
-    w.put<std::int64_t>(kf.utime);
-    w.putPose(kf.uncorrected);
-    w.putPoints(kf.cloud);
-    const ScanContext& sc = database_.context(static_cast<int>(k));
-    w.put<std::int32_t>(sc.rings());
-    w.put<std::int32_t>(sc.sectors());
-    w.put<std::int32_t>(sc.shiftSearchRadius());
-    w.putMatrix(sc.descriptor());
-    w.putMatrix(chain_.stepCovariance(static_cast<int>(k)));
-    w.putPose(graph_.pose(static_cast<int>(k)));
-  }
+  for (int k = 0; k < graph_.size(); ++k) w.putPose(graph_.pose(k));
   w.put<std::uint64_t>(graph_.edges().size());
   for (const PoseGraphEdge& e : graph_.edges()) {
     w.put<std::int32_t>(e.from);
@@ -93,30 +96,35 @@ std::string LoopCloser::saveState() const {
   return w.bytes();
 }
 
-bool LoopCloser::restoreState(const std::string& bytes) {
-  ByteReader r(bytes);
+std::size_t LoopCloser::keyframesInState(const std::string& state) {
+  ByteReader r(state);
+  const auto n = r.getCount(96);
+  return r.ok() ? n : 0;
+}
+
+bool LoopCloser::restoreState(const std::string& state, const std::vector<std::string>& keyframe_records) {
+  ByteReader r(state);
   LoopCloser restored(config_);
-  // Per keyframe at least: utime, pose, an empty cloud, the context's shape, its covariance, its graph pose.
-  const auto n = r.getCount(8 + 96 + 8 + 12 + 288 + 96);
+  const auto n = r.getCount(96);  // a graph pose per keyframe
+  if (!r.ok() || keyframe_records.size() < n) return false;
   for (std::uint64_t k = 0; k < n && r.ok(); ++k) {
+    const std::string& record = keyframe_records[k];
+    ByteReader kr(record);
     Keyframe kf;
-    kf.utime = r.get<std::int64_t>();
-    kf.uncorrected = r.getPose();
-    kf.cloud = r.getPoints<Eigen::Vector3f>();
-    const int rings = r.get<std::int32_t>(), sectors = r.get<std::int32_t>(), radius = r.get<std::int32_t>();
-    if (rings <= 0 || sectors <= 0 || rings > 1000 || sectors > 1000 ||
-        static_cast<std::uint64_t>(rings) * static_cast<std::uint64_t>(sectors) * 4 > bytes.size()) {
-      r.fail();
-      break;
-    }
+    kf.utime = kr.get<std::int64_t>();
+    kf.uncorrected = kr.getPose();
+    kf.cloud = kr.getPoints<Eigen::Vector3f>();
+    const int rings = kr.get<std::int32_t>(), sectors = kr.get<std::int32_t>(), radius = kr.get<std::int32_t>();
+    if (!kr.ok() || rings <= 0 || sectors <= 0 || rings > 1000 || sectors > 1000 ||
+        static_cast<std::uint64_t>(rings) * static_cast<std::uint64_t>(sectors) * 4 > record.size())
+      return false;
     Eigen::MatrixXf descriptor(rings, sectors);
     for (int i = 0; i < rings; ++i)
-      for (int j = 0; j < sectors; ++j) descriptor(i, j) = r.get<float>();
-    const Matrix6d step = r.getMatrix<Matrix6d>();
-    const Eigen::Isometry3d graph_pose = r.getPose();
-    if (!r.ok()) break;
+      for (int j = 0; j < sectors; ++j) descriptor(i, j) = kr.get<float>();
+    const Matrix6d step = kr.getMatrix<Matrix6d>();
+    if (!kr.ok() || !kr.atEnd()) return false;
     restored.chain_.add(kf.uncorrected, step);
-    restored.graph_.addNode(graph_pose);
+    restored.graph_.addNode(r.getPose());
     restored.database_.add(ScanContext::fromDescriptor(descriptor, radius), kf.utime);
     restored.keyframes_.push_back(std::move(kf));
   }

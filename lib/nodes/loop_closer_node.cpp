@@ -9,6 +9,7 @@
 #include "msg/convert.hpp"
 #include "nodes/products.hpp"
 #include "nodes/run_state.hpp"
+#include "runtime/record_log.hpp"
 
 #include <adit/command_t.hpp>
 #include <adit/map_update_t.hpp>
@@ -17,6 +18,8 @@
 
 namespace adit::nodes {
 namespace {
+
+constexpr const char* kKeyframesKind = "loop_closer_keyframes";
 
 // What a command said, fit for one log line: at most 80 characters, anything unprintable as '?'.
 std::string printable(const std::string& text) {
@@ -68,8 +71,8 @@ class LoopCloserNode : public runtime::Node, public WritesProducts {
  protected:
   void onFinish() override {
     if (!state_.live()) return;  // replay writes its products itself
+    saveProducts({});  // first: what the user asked for, before the stop's grace time runs out
     checkpoint();
-    saveProducts({});
   }
 
  private:
@@ -129,7 +132,19 @@ class LoopCloserNode : public runtime::Node, public WritesProducts {
     }
   }
 
+  // Keyframes go to an append-only log (each written once); the checkpoint holds the rest and how many
+  // keyframes it covers, so a checkpoint costs the new keyframes plus the graph, not the whole run.
   void checkpoint() {
+    try {
+      if (!keyframes_log_.isOpen()) keyframes_log_.create(keyframesPath(), kKeyframesKind, state_.folder().run_id);
+      std::vector<std::string> records;
+      for (auto k = keyframes_log_.size(); k < closer_.keyframes().size(); ++k)
+        records.push_back(closer_.keyframeRecord(static_cast<int>(k)));
+      keyframes_log_.append(records);
+    } catch (const std::exception& e) {
+      reportError("checkpoint_failed", std::string("keyframes not written: ") + e.what());
+      return;  // the previous checkpoint still matches the keyframes on disk
+    }
     ByteWriter w;
     w.putString(closer_.saveState());
     w.put<std::uint64_t>(uncorrected_.size());
@@ -144,18 +159,32 @@ class LoopCloserNode : public runtime::Node, public WritesProducts {
 
   std::string restore(const std::string& bytes) {
     ByteReader r(bytes);
-    LoopCloser closer(closer_.config());
-    if (!closer.restoreState(r.getString()) || !r.ok()) return "malformed loop closer state";
+    const std::string state = r.getString();
     Trajectory uncorrected(r.getCount(8 + 96));
     for (StampedPose& p : uncorrected) {
       p.utime = r.get<std::int64_t>();
       p.pose = r.getPose();
     }
-    if (!r.ok() || !r.atEnd()) return "malformed trajectory";
+    if (!r.ok() || !r.atEnd()) return "malformed checkpoint";
+    const std::size_t n = LoopCloser::keyframesInState(state);
+    const runtime::LoadedRecords records = runtime::loadRecords(keyframesPath(), kKeyframesKind, state_.folder().run_id, n);
+    if (!records.error.empty()) return records.error;
+    if (records.records.size() < n)
+      return keyframesPath() + " holds " + std::to_string(records.records.size()) + " of the " + std::to_string(n) +
+             " keyframes the checkpoint names";
+    LoopCloser closer(closer_.config());
+    if (!closer.restoreState(state, records.records)) return "malformed loop closer state";
+    try {
+      keyframes_log_.continueAfter(keyframesPath(), n);  // cut keyframes written after the checkpoint
+    } catch (const std::exception& e) {
+      return e.what();
+    }
     closer_ = std::move(closer);
     uncorrected_ = std::move(uncorrected);
     return "";
   }
+
+  std::string keyframesPath() const { return state_.folder().file("loop_closer.keyframes"); }
 
   void publishGraph(std::int64_t utime, const LoopCloser::Result& result) {
     adit::pose_graph_t g;
@@ -206,6 +235,7 @@ class LoopCloserNode : public runtime::Node, public WritesProducts {
   int checkpoint_keyframes_;
   MapUpdateTracker updates_;
   RunState state_;
+  runtime::RecordLog keyframes_log_;
   Trajectory uncorrected_;
 };
 

@@ -58,7 +58,7 @@ class OdometryNode : public runtime::Node {
   // in the same odometry frame, from the last pose moved on at the last velocity. Never back to identity.
   void onTimeJump(const std::string& port) override {
     if (port == "features") {
-      if (odometry_.lastUtime() >= 0) resume_ = Resume{odometry_.lastUtime(), odometry_.pose(), odometry_.heldVelocity()};
+      if (odometry_.lastUtime() >= 0) resume_ = Resume{odometry_.lastUtime(), odometry_.pose(), odometry_.lastVelocity()};
       odometry_.reset();
       previous_.reset();
     }
@@ -113,7 +113,7 @@ class OdometryNode : public runtime::Node {
     ByteWriter w;
     w.put<std::int64_t>(odometry_.lastUtime());
     w.putPose(odometry_.pose());
-    w.putMatrix(odometry_.heldVelocity());
+    w.putMatrix(odometry_.lastVelocity());
     const std::string error = state_.save(w.bytes());
     last_checkpoint_utime_ = odometry_.lastUtime();
     if (error.empty()) count("checkpoints");

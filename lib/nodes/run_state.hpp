@@ -8,6 +8,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include <filesystem>
 #include <functional>
 #include <string>
 
@@ -17,7 +18,15 @@ class RunState {
  public:
   explicit RunState(std::string kind) : kind_(std::move(kind)) {}
 
-  void setFolder(const runtime::RunFolder& folder) { folder_ = folder; }
+  // Also removes temp files a killed predecessor left half-written ("<kind>.ckpt.tmp.<pid>").
+  void setFolder(const runtime::RunFolder& folder) {
+    folder_ = folder;
+    if (!folder_.live) return;
+    std::error_code ec;
+    const std::string stale = kind_ + ".ckpt.tmp.";
+    for (const auto& entry : std::filesystem::directory_iterator(folder_.dir, ec))
+      if (entry.path().filename().string().rfind(stale, 0) == 0) std::filesystem::remove(entry.path(), ec);
+  }
   const runtime::RunFolder& folder() const { return folder_; }
   bool live() const { return folder_.live; }
   std::string checkpointPath() const { return folder_.file(kind_ + ".ckpt"); }

@@ -35,11 +35,16 @@ TEST(Resume, LoopCloserStateRoundTripsExactly) {
     closer.process(adit::msg::fromMessage(m), adit::msg::fromMessage(m.features.cloud));
   }
   const std::string bytes = closer.saveState();
+  std::vector<std::string> records;
+  for (int k = 0; k < 12; ++k) records.push_back(closer.keyframeRecord(k));
   adit::LoopCloser restored;
-  ASSERT_TRUE(restored.restoreState(bytes));
+  ASSERT_TRUE(restored.restoreState(bytes, records));
   EXPECT_EQ(restored.saveState(), bytes);
+  EXPECT_EQ(restored.keyframeRecord(11), records[11]);
   EXPECT_EQ(restored.keyframes().size(), 12u);
-  EXPECT_FALSE(restored.restoreState(bytes.substr(0, bytes.size() - 3)));
+  EXPECT_FALSE(restored.restoreState(bytes.substr(0, bytes.size() - 3), records));
+  records.pop_back();
+  EXPECT_FALSE(restored.restoreState(bytes, records)) << "a missing keyframe record";
   EXPECT_EQ(restored.keyframes().size(), 12u) << "a failed restore must leave the state alone";
 }
 
@@ -71,6 +76,25 @@ TEST(Resume, CheckpointOfAnotherRunOrDamagedIsRefusedWithAFreshStart) {
   auto truncated = runLoopCloser(adit::test::liveFolder(run.path(), "run-1", 1), 100, 3);
   EXPECT_EQ(counter(*truncated, "checkpoint_refused"), 1);
   EXPECT_EQ(counter(*truncated, "keyframes"), 3) << "fresh start";
+}
+
+TEST(Resume, KeyframesWrittenAfterTheCheckpointAreCutAndATornLogIsRefused) {
+  adit::test::TempFolder run;
+  runLoopCloser(adit::test::liveFolder(run.path()), 0, 10);  // checkpoint on stop: 10 keyframes
+  const std::string checkpoint = readFile(run.file("loop_closer.ckpt"));
+  auto later = runLoopCloser(adit::test::liveFolder(run.path(), "run-1", 1), 10, 15);  // 25 on disk now
+  std::ofstream(run.file("loop_closer.ckpt"), std::ios::binary | std::ios::trunc) << checkpoint;  // "crash" at 10
+  auto resumed = runLoopCloser(adit::test::liveFolder(run.path(), "run-1", 2), 10, 5);
+  EXPECT_EQ(counter(*resumed, "recovered_keyframes"), 10);
+  EXPECT_EQ(counter(*resumed, "keyframes"), 15);
+  auto again = runLoopCloser(adit::test::liveFolder(run.path(), "run-1", 3), 15, 0);
+  EXPECT_EQ(counter(*again, "recovered_keyframes"), 15) << "the log was cut at 10 and continued";
+
+  const std::string log = readFile(run.file("loop_closer.keyframes"));
+  std::ofstream(run.file("loop_closer.keyframes"), std::ios::binary | std::ios::trunc) << log.substr(0, log.size() / 2);
+  auto torn = runLoopCloser(adit::test::liveFolder(run.path(), "run-1", 4), 15, 2);
+  EXPECT_EQ(counter(*torn, "checkpoint_refused"), 1);
+  EXPECT_EQ(counter(*torn, "keyframes"), 2) << "fresh start";
 }
 
 TEST(Resume, NoResumeWithoutAGivenFolderOrARestart) {
