@@ -55,10 +55,10 @@ run() {  # name, kill spacing (0 = none)
 
 RUN_A=$(run undisturbed 0)
 read -r A_RMSE A_MAX < <(ape "$OUT/undisturbed/gt.tum" "$RUN_A/trajectory.tum")
-"$BIN/adit" replay "$OUT/undisturbed/sensors.lcmlog" -o "$OUT/undisturbed/replay" >/dev/null
-read -r R_RMSE R_MAX < <(ape "$OUT/undisturbed/gt.tum" "$OUT/undisturbed/replay/trajectory.tum")
 RUN_B=$(run killed $((DURATION / 5)))
 read -r B_RMSE B_MAX < <(ape "$OUT/killed/gt.tum" "$RUN_B/trajectory.tum")
+"$BIN/adit" replay "$OUT/undisturbed/sensors.lcmlog" -o "$OUT/undisturbed/replay" --record '^$' >/dev/null
+read -r R_RMSE R_MAX < <(ape "$OUT/undisturbed/gt.tum" "$OUT/undisturbed/replay/trajectory.tum")
 
 echo "live runs: $WORLD, $DURATION s, vlp16, real time over UDP multicast"
 echo "  A live (undisturbed)      APE rmse $A_RMSE m, max $A_MAX m"
@@ -66,6 +66,7 @@ echo "  A adit replay of its log  APE rmse $R_RMSE m, max $R_MAX m"
 echo "  B each stage killed once  APE rmse $B_RMSE m, max $B_MAX m ($(awk -v a="$A_RMSE" -v b="$B_RMSE" 'BEGIN { printf "%+.0f %%", (b / a - 1) * 100 }') vs A)"
 echo "  B restarts:"; grep "^restart" "$OUT/killed/report.txt" | sed 's/^/    /'
 echo "  MAP_UPDATE (A): $(grep map_update "$OUT/undisturbed/report.txt")"
+echo "  sweeps reaching the map owner: A $(wc -l < "$RUN_A/trajectory.tum"), B $(wc -l < "$RUN_B/trajectory.tum"), replay $(wc -l < "$OUT/undisturbed/replay/trajectory.tum")"
 echo "  map vs world A live:   $("$BIN/map_vs_world" "$RUN_A/map.pcd" "$OUT/world.pcd" "$OUT/undisturbed/gt.tum" "$RUN_A/trajectory.tum")"
 echo "  map vs world A replay: $("$BIN/map_vs_world" "$OUT/undisturbed/replay/map.pcd" "$OUT/world.pcd" "$OUT/undisturbed/gt.tum" "$OUT/undisturbed/replay/trajectory.tum")"
 echo "  map vs world B:        $("$BIN/map_vs_world" "$RUN_B/map.pcd" "$OUT/world.pcd" "$OUT/killed/gt.tum" "$RUN_B/trajectory.tum")"

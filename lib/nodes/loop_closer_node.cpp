@@ -16,6 +16,9 @@
 #include <adit/pose_graph_t.hpp>
 #include <spdlog/spdlog.h>
 
+#include <atomic>
+#include <memory>
+
 namespace adit::nodes {
 namespace {
 
@@ -73,6 +76,8 @@ class LoopCloserNode : public runtime::Node, public WritesProducts {
     if (!state_.live()) return;  // replay writes its products itself
     saveProducts({});  // first: what the user asked for, before the stop's grace time runs out
     checkpoint();
+    state_.flush();
+    reportCheckpoints();
   }
 
  private:
@@ -92,6 +97,7 @@ class LoopCloserNode : public runtime::Node, public WritesProducts {
     const LoopCloserStats& s = closer_.stats();
     const bool periodic = result.keyframe_added && checkpoint_keyframes_ > 0 && s.keyframes % checkpoint_keyframes_ == 0;
     if (state_.live() && (periodic || result.graph_updated)) checkpoint();
+    if (state_.live()) reportCheckpoints();
     setCount("keyframes", s.keyframes);
     setCount("loop_candidates", s.candidates);
     setCount("loops_accepted", s.accepted);
@@ -133,18 +139,14 @@ class LoopCloserNode : public runtime::Node, public WritesProducts {
   }
 
   // Keyframes go to an append-only log (each written once); the checkpoint holds the rest and how many
-  // keyframes it covers, so a checkpoint costs the new keyframes plus the graph, not the whole run.
+  // keyframes it covers, so a checkpoint costs the new keyframes plus the graph, not the whole run. Both are
+  // written on the writer thread (a slow disk must not stall loop detection); a job superseded before it
+  // ran is covered by the next, which carries every keyframe the log does not hold yet.
   void checkpoint() {
-    try {
-      if (!keyframes_log_.isOpen()) keyframes_log_.create(keyframesPath(), kKeyframesKind, state_.folder().run_id);
-      std::vector<std::string> records;
-      for (auto k = keyframes_log_.size(); k < closer_.keyframes().size(); ++k)
-        records.push_back(closer_.keyframeRecord(static_cast<int>(k)));
-      keyframes_log_.append(records);
-    } catch (const std::exception& e) {
-      reportError("checkpoint_failed", std::string("keyframes not written: ") + e.what());
-      return;  // the previous checkpoint still matches the keyframes on disk
-    }
+    const std::size_t first = keyframes_written_->load();
+    std::vector<std::string> records;
+    for (std::size_t k = first; k < closer_.keyframes().size(); ++k)
+      records.push_back(closer_.keyframeRecord(static_cast<int>(k)));
     ByteWriter w;
     w.putString(closer_.saveState());
     w.put<std::uint64_t>(uncorrected_.size());
@@ -152,9 +154,22 @@ class LoopCloserNode : public runtime::Node, public WritesProducts {
       w.put<std::int64_t>(p.utime);
       w.putPose(p.pose);
     }
-    const std::string error = state_.save(w.bytes());
-    if (error.empty()) count("checkpoints");
-    else reportError("checkpoint_failed", error);
+    state_.submit([this, first, records = std::move(records), payload = w.bytes()] {
+      try {
+        if (!keyframes_log_.isOpen()) keyframes_log_.create(keyframesPath(), kKeyframesKind, state_.folder().run_id);
+        if (first > keyframes_log_.size()) return std::string("keyframe log behind its checkpoint");
+        keyframes_log_.append({records.begin() + static_cast<std::ptrdiff_t>(keyframes_log_.size() - first), records.end()});
+        keyframes_written_->store(keyframes_log_.size());
+      } catch (const std::exception& e) {
+        return std::string("keyframes not written: ") + e.what();  // the previous checkpoint still matches
+      }
+      return state_.save(payload);
+    });
+  }
+
+  void reportCheckpoints() {
+    for (const std::string& e : state_.takeErrors()) reportError("checkpoint_failed", e);
+    setCount("checkpoints", state_.saved());
   }
 
   std::string restore(const std::string& bytes) {
@@ -176,6 +191,7 @@ class LoopCloserNode : public runtime::Node, public WritesProducts {
     if (!closer.restoreState(state, records.records)) return "malformed loop closer state";
     try {
       keyframes_log_.continueAfter(keyframesPath(), n);  // cut keyframes written after the checkpoint
+      keyframes_written_->store(n);
     } catch (const std::exception& e) {
       return e.what();
     }
@@ -234,8 +250,9 @@ class LoopCloserNode : public runtime::Node, public WritesProducts {
   double map_voxel_;
   int checkpoint_keyframes_;
   MapUpdateTracker updates_;
-  RunState state_;
-  runtime::RecordLog keyframes_log_;
+  runtime::RecordLog keyframes_log_;  // the writer thread's, once the run started
+  std::shared_ptr<std::atomic<std::size_t>> keyframes_written_ = std::make_shared<std::atomic<std::size_t>>(0);
+  RunState state_;  // after what its jobs use: its writer thread stops first
   Trajectory uncorrected_;
 };
 

@@ -68,7 +68,10 @@ class MapperNode : public runtime::Node, public WritesProducts {
 
  protected:
   void onFinish() override {
-    if (state_.live()) checkpoint();
+    if (!state_.live()) return;
+    checkpoint();
+    state_.flush();
+    reportCheckpoints();
   }
 
  private:
@@ -94,6 +97,7 @@ class MapperNode : public runtime::Node, public WritesProducts {
       checkpoint();
       last_checkpoint_utime_ = mapped.utime;
     }
+    reportCheckpoints();
   }
 
   // The graph's correction is total (relative to uncorrected poses); apply what is new to us.
@@ -117,9 +121,12 @@ class MapperNode : public runtime::Node, public WritesProducts {
     w.putPose(applied_);
     w.putPoints(s.corners);
     w.putPoints(s.surfs);
-    const std::string error = state_.save(w.bytes());
-    if (error.empty()) count("checkpoints");
-    else reportError("checkpoint_failed", error);
+    state_.saveLater(w.bytes());
+  }
+
+  void reportCheckpoints() {
+    for (const std::string& e : state_.takeErrors()) reportError("checkpoint_failed", e);
+    setCount("checkpoints", state_.saved());
   }
 
   std::string restore(const std::string& bytes) {

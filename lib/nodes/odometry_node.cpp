@@ -67,6 +67,8 @@ class OdometryNode : public runtime::Node {
 
   void onFinish() override {
     if (state_.live() && odometry_.lastUtime() >= 0) checkpoint();
+    state_.flush();
+    reportCheckpoints();
   }
 
  private:
@@ -97,6 +99,7 @@ class OdometryNode : public runtime::Node {
     adit::odometry_t out = msg::toMessage(pose, &features);
     publish("odometry", out);
     if (state_.live() && pose.utime - last_checkpoint_utime_ >= checkpoint_period_us_) checkpoint();
+    reportCheckpoints();
   }
 
   void resumeFrom(const Resume& r, std::int64_t utime) {
@@ -114,10 +117,13 @@ class OdometryNode : public runtime::Node {
     w.put<std::int64_t>(odometry_.lastUtime());
     w.putPose(odometry_.pose());
     w.putMatrix(odometry_.lastVelocity());
-    const std::string error = state_.save(w.bytes());
+    state_.saveLater(w.bytes());
     last_checkpoint_utime_ = odometry_.lastUtime();
-    if (error.empty()) count("checkpoints");
-    else reportError("checkpoint_failed", error);
+  }
+
+  void reportCheckpoints() {
+    for (const std::string& e : state_.takeErrors()) reportError("checkpoint_failed", e);
+    setCount("checkpoints", state_.saved());
   }
 
   std::string restore(const std::string& bytes) {

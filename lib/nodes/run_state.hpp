@@ -3,6 +3,7 @@
 // process down.
 #pragma once
 
+#include "runtime/background_writer.hpp"
 #include "runtime/checkpoint.hpp"
 #include "runtime/run_folder.hpp"
 
@@ -10,6 +11,7 @@
 
 #include <filesystem>
 #include <functional>
+#include <memory>
 #include <string>
 
 namespace adit::nodes {
@@ -22,6 +24,7 @@ class RunState {
   void setFolder(const runtime::RunFolder& folder) {
     folder_ = folder;
     if (!folder_.live) return;
+    writer_ = std::make_unique<runtime::BackgroundWriter>();
     std::error_code ec;
     const std::string stale = kind_ + ".ckpt.tmp.";
     for (const auto& entry : std::filesystem::directory_iterator(folder_.dir, ec))
@@ -50,6 +53,20 @@ class RunState {
     return error.empty();
   }
 
+  // Saves on the writer thread (never stalls the stage); a save not yet started is superseded by a newer
+  // one. Errors and successes are collected with takeErrors() / saved().
+  void saveLater(std::string payload) {
+    submit([this, payload = std::move(payload)] { return save(payload); });
+  }
+  void submit(runtime::BackgroundWriter::Job job) {
+    if (writer_) writer_->submit(std::move(job));
+  }
+  void flush() {
+    if (writer_) writer_->flush();
+  }
+  std::vector<std::string> takeErrors() { return writer_ ? writer_->takeErrors() : std::vector<std::string>{}; }
+  std::int64_t saved() const { return writer_ ? writer_->succeeded() : 0; }
+
   // Returns "" or the error (the previous checkpoint is then intact).
   std::string save(const std::string& payload) const {
     try {
@@ -63,6 +80,7 @@ class RunState {
  private:
   std::string kind_;
   runtime::RunFolder folder_;
+  std::unique_ptr<runtime::BackgroundWriter> writer_;  // live only: replay never starts a thread
 };
 
 }  // namespace adit::nodes
