@@ -19,6 +19,7 @@
 #include "loop/scan_context_database.hpp"
 
 #include <optional>
+#include <string>
 #include <vector>
 
 namespace adit {
@@ -123,6 +124,16 @@ class LoopCloser {
   const LoopCloserStats& stats() const { return stats_; }
   const LoopCloserConfig& config() const { return config_; }
   Eigen::Isometry3d correction(int keyframe) const;  // X_k * U_k^-1
+
+  // The state as bytes for a checkpoint (loop_closer_state.cpp), in two parts: one record per keyframe
+  // (pose, cloud, Scan Context, step covariance: written once, appended as keyframes come), and the rest
+  // (graph poses and edges, loops, counters: small, rewritten). restoreState() takes the first
+  // keyframes (as many as the state names) and leaves this object unchanged if anything is malformed.
+  std::string keyframeRecord(int keyframe) const;
+  std::string saveState() const;
+  bool restoreState(const std::string& state, const std::vector<std::string>& keyframe_records);
+  // Keyframes a saved state refers to (0 if malformed).
+  static std::size_t keyframesInState(const std::string& state);
 
  private:
   bool isKeyframe(const Eigen::Isometry3d& pose) const;

@@ -15,6 +15,8 @@ class OdometryChain {
   void add(const Eigen::Isometry3d& T_world_keyframe, const Matrix6d& step_covariance);
   int size() const { return static_cast<int>(poses_.size()); }
   const Eigen::Isometry3d& pose(int k) const { return poses_[static_cast<std::size_t>(k)]; }
+  // Covariance of the step k-1 -> k as added (k = 0: what was given for the first pose).
+  const Matrix6d& stepCovariance(int k) const { return step_covariances_[static_cast<std::size_t>(k)]; }
 
   // Covariance of T_a_b accumulated along the chain a..b (a < b), expressed in b's frame:
   // sum over steps k in (a, b] of Ad(T_b_k) Sigma_k Ad(T_b_k)^T. Zero when a >= b.

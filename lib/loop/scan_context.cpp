@@ -38,6 +38,13 @@ ScanContext ScanContext::build(const std::vector<Eigen::Vector3f>& points, const
     float& bin = sc.descriptor_(ring, sector);
     bin = std::max(bin, value);
   }
+  return fromDescriptor(sc.descriptor_, sc.shift_search_radius_);
+}
+
+ScanContext ScanContext::fromDescriptor(const Eigen::MatrixXf& descriptor, int shift_search_radius) {
+  ScanContext sc;
+  sc.descriptor_ = descriptor;
+  sc.shift_search_radius_ = shift_search_radius;
   sc.occupied_bins_ = static_cast<int>((sc.descriptor_.array() > 0.0f).count());
   sc.ring_key_ = sc.descriptor_.rowwise().mean();
   sc.sector_key_ = sc.descriptor_.colwise().mean().transpose();

@@ -40,6 +40,8 @@ class ScanContext {
   ScanContext() = default;
   // Points are in a sensor-centred frame whose z axis is (close to) vertical. Non-finite points are ignored.
   static ScanContext build(const std::vector<Eigen::Vector3f>& points, const ScanContextConfig& config);
+  // The context whose descriptor() is `descriptor` (restoring a checkpoint): identical to the one built.
+  static ScanContext fromDescriptor(const Eigen::MatrixXf& descriptor, int shift_search_radius);
 
   // Distance in [0, 1] (1 - mean cosine similarity of the columns occupied in both) and the best column shift s:
   // this context looks like `other` rotated by +s sectors about z (this = Rz(yaw) * other, see yawOfShift).

@@ -180,6 +180,26 @@ void ScanToMapMapper::applyCorrection(const Eigen::Isometry3d& T_corrected_uncor
   corrected_ = true;
 }
 
+ScanToMapMapper::State ScanToMapMapper::state() const {
+  State s;
+  s.utime = has_previous_ ? previous_utime_ : -1;
+  s.T_map_odom = T_map_odom_;
+  s.previous_odometry = previous_odometry_;
+  s.corners = corner_map_.points();
+  s.surfs = surf_map_.points();
+  return s;
+}
+
+void ScanToMapMapper::restore(const State& s) {
+  *this = ScanToMapMapper(config_);
+  T_map_odom_ = s.T_map_odom;
+  previous_odometry_ = s.previous_odometry;
+  has_previous_ = s.utime >= 0;
+  previous_utime_ = s.utime;
+  corner_map_.insert(s.corners);
+  surf_map_.insert(s.surfs);
+}
+
 std::vector<Eigen::Vector3f> ScanToMapMapper::globalMap(double voxel_size) const {
   return global_map_.points(voxel_size);
 }

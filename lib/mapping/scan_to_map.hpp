@@ -73,6 +73,18 @@ class ScanToMapMapper {
   // The global map downsampled to voxel_size (m), deterministic order: what map.pcd holds.
   std::vector<Eigen::Vector3f> globalMap(double voxel_size) const;
 
+  // What a restarted mapper needs to continue: the drift correction, the last odometry pose it saw and the
+  // local map (the global map is the loop closer's job and is not part of it).
+  struct State {
+    std::int64_t utime = -1;  // last sweep; -1: none yet
+    Eigen::Isometry3d T_map_odom = Eigen::Isometry3d::Identity();
+    Eigen::Isometry3d previous_odometry = Eigen::Isometry3d::Identity();
+    std::vector<Eigen::Vector3d> corners, surfs;
+  };
+  State state() const;
+  // Continues from `state`: the next sweep is registered against the restored local map.
+  void restore(const State& state);
+
   const VoxelMap& cornerMap() const { return corner_map_; }
   const VoxelMap& surfMap() const { return surf_map_; }
   const Eigen::Isometry3d& mapFromOdometry() const { return T_map_odom_; }

@@ -3,6 +3,7 @@
 #include <adit/features_t.hpp>
 #include <adit/imu_t.hpp>
 #include <adit/loop_closure_t.hpp>
+#include <adit/map_update_t.hpp>
 #include <adit/odometry_t.hpp>
 #include <adit/point_cloud_t.hpp>
 #include <adit/pose_graph_t.hpp>
@@ -28,6 +29,7 @@ std::string messageTypeName(const std::uint8_t* data, std::size_t size) {
   if (hasHash<adit::odometry_t>(hash)) return "odometry_t";
   if (hasHash<adit::loop_closure_t>(hash)) return "loop_closure_t";
   if (hasHash<adit::pose_graph_t>(hash)) return "pose_graph_t";
+  if (hasHash<adit::map_update_t>(hash)) return "map_update_t";
   if (hasHash<adit::status_t>(hash)) return "status_t";
   return "";
 }

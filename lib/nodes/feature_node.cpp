@@ -5,10 +5,17 @@
 #include "nodes/imu_buffer.hpp"
 
 #include <deque>
+#include <map>
+#include <optional>
 
 namespace adit::nodes {
 namespace {
 
+// Deskewing must not depend on process scheduling, so that a live run gives what replay gives: sweep k is
+// deskewed with the constant-velocity motion between the odometry poses of sweeps k-2 and k-1 exactly, and
+// with the IMU samples up to its own end only. In lockstep those poses are always there when sweep k
+// arrives. Live, if ODOM_SCAN of sweep k-1 is still on its way when sweep k arrives, sweep k waits for it
+// (or for sweep k+1, whichever comes first: a dead odometry costs one sweep of latency, never a stall).
 class FeatureNode : public runtime::Node {
  public:
   explicit FeatureNode(const Config& config)
@@ -24,36 +31,72 @@ class FeatureNode : public runtime::Node {
     advertise("features", "FEATURES");
   }
 
+ public:
+  // Nothing to recover (a few poses and IMU samples): a restart only says so on STATUS.
+  void useRunFolder(const runtime::RunFolder& folder) override {
+    if (folder.live && folder.restart_count > 0) setCount("restarted", 1);
+  }
+
  protected:
   void onTimeJump(const std::string& port) override {
-    if (port == "points" || port == "odometry") poses_.clear();
+    if (port == "points" || port == "odometry") {
+      poses_.clear();
+      sweeps_.clear();
+    }
     if (port == "imu") imu_.clear();
   }
+  void onFinish() override { processHeld(); }
 
  private:
   void onOdometry(const adit::odometry_t& m) {
-    poses_.push_back({m.header.utime, msg::fromMessage(m).pose});
-    if (poses_.size() > 2) poses_.pop_front();
+    odometry_seen_ = true;
+    poses_[m.header.utime] = msg::fromMessage(m).pose;
+    while (poses_.size() > 8) poses_.erase(poses_.begin());
+    if (held_ && !sweeps_.empty() && m.header.utime == sweeps_.back()) processHeld();
   }
 
-  // Constant velocity: the motion between the last two odometry poses, if they are recent enough.
+  void onSweep(const adit::point_cloud_t& m) {
+    processHeld();  // its prior never came: go on without it
+    LidarScan scan = msg::fromMessage(m);
+    const bool prior_pending = odometry_seen_ && !sweeps_.empty() && !poses_.count(sweeps_.back());
+    if (prior_pending) {
+      held_ = std::move(scan);
+      count("held_for_prior");
+      return;
+    }
+    process(scan);
+  }
+
+  void processHeld() {
+    if (!held_) return;
+    const LidarScan scan = std::move(*held_);
+    held_.reset();
+    process(scan);
+  }
+
+  // Constant velocity between the poses of the two previous sweeps, if both are known and recent enough.
   MotionPrior motionPrior(std::int64_t sweep_utime) const {
     MotionPrior prior;
-    if (poses_.size() < 2) return prior;
-    const double age = toSeconds(sweep_utime - poses_.back().utime);
-    const double dt = toSeconds(poses_.back().utime - poses_.front().utime);
+    if (sweeps_.size() < 2) return prior;
+    const auto a = poses_.find(sweeps_[sweeps_.size() - 2]), b = poses_.find(sweeps_.back());
+    if (a == poses_.end() || b == poses_.end()) return prior;
+    const double age = toSeconds(sweep_utime - b->first);
+    const double dt = toSeconds(b->first - a->first);
     if (age <= 0 || age > max_prior_age_s_ || dt <= 0) return prior;
-    prior.T_prev_curr = poses_.front().pose.inverse() * poses_.back().pose;
+    prior.T_prev_curr = a->second.inverse() * b->second;
     prior.dt_s = dt;
     prior.valid = true;
     return prior;
   }
 
-  void onSweep(const adit::point_cloud_t& m) {
-    const LidarScan scan = msg::fromMessage(m);
+  void process(const LidarScan& scan) {
     if (scan.points.empty()) reportDrop("empty_scan", "sweep at utime " + std::to_string(scan.utime) + " has no points");
-    const std::vector<ImuSample> imu = imu_.samples();
+    std::vector<ImuSample> imu = imu_.samples();
+    // Only what was measured up to the sweep's end: later samples may or may not have arrived yet.
+    while (!imu.empty() && imu.back().utime > scan.utime) imu.pop_back();
     const FeatureSet features = extractor_.process(scan, imu, motionPrior(scan.utime));
+    sweeps_.push_back(scan.utime);
+    if (sweeps_.size() > 2) sweeps_.pop_front();
     count("points_in", features.points_in);
     count("removed_invalid", features.removed_invalid);
     count("removed_range", features.removed_range);
@@ -67,7 +110,10 @@ class FeatureNode : public runtime::Node {
   FeatureExtractor extractor_;
   ImuBuffer imu_;
   double max_prior_age_s_ = 0.3;
-  std::deque<StampedPose> poses_;
+  std::deque<std::int64_t> sweeps_;                 // utimes of the last two sweeps processed
+  std::map<std::int64_t, Eigen::Isometry3d> poses_;  // recent ODOM_SCAN poses by sweep utime
+  std::optional<LidarScan> held_;                    // a sweep waiting for the previous sweep's pose
+  bool odometry_seen_ = false;                       // without an odometry stage, nothing to wait for
 };
 
 }  // namespace

@@ -1,41 +1,83 @@
 #include "nodes/loop_closer_node.hpp"
 
+#include "core/byte_codec.hpp"
 #include "core/geometry.hpp"
-#include "eval/trajectory_io.hpp"
-#include "io/pcd.hpp"
 #include "loop/loop_closer.hpp"
 #include "loop/pose_graph.hpp"
+#include "map/map_products.hpp"
+#include "map/map_updates.hpp"
 #include "msg/convert.hpp"
 #include "nodes/products.hpp"
+#include "nodes/run_state.hpp"
+#include "runtime/record_log.hpp"
 
+#include <adit/command_t.hpp>
+#include <adit/map_update_t.hpp>
 #include <adit/pose_graph_t.hpp>
+#include <spdlog/spdlog.h>
 
-#include <filesystem>
+#include <atomic>
+#include <memory>
 
 namespace adit::nodes {
 namespace {
 
+constexpr const char* kKeyframesKind = "loop_closer_keyframes";
+
+// What a command said, fit for one log line: at most 80 characters, anything unprintable as '?'.
+std::string printable(const std::string& text) {
+  std::string out = text.substr(0, 80);
+  for (char& c : out)
+    if (c < 0x20 || c > 0x7e) c = '?';
+  return text.size() > 80 ? out + "..." : out;
+}
+
+// The loop closer owns the corrected map of a run: its keyframes are the submaps (each keyframe's cloud
+// anchored to the keyframe), the pose graph places them. It answers save_map, publishes MAP_UPDATE for
+// viewers, and checkpoints keyframes and graph so that a restart keeps what was mapped before it.
 class LoopCloserNode : public runtime::Node, public WritesProducts {
  public:
   explicit LoopCloserNode(const Config& config)
       : Node("loop_closer"), closer_(loopCloserConfigFrom(config)),
-        map_voxel_(config.get<double>("loop.map_voxel", 0.1)) {
+        map_voxel_(config.get<double>("loop.map_voxel", 0.1)),
+        // Keyframes between checkpoints (also written after every loop and on stop). 0 = never.
+        checkpoint_keyframes_(config.get<int>("loop.node.checkpoint_keyframes", 10)),
+        updates_(mapUpdateConfigFrom(config)), state_("loop_closer") {
     subscribe<adit::odometry_t>("mapped", "ODOM_MAPPED", [this](const adit::odometry_t& m) { onMapped(m); });
+    subscribe<adit::command_t>("command", "MAPPER_COMMAND", [this](const adit::command_t& m) { onCommand(m); },
+                               runtime::InputKind::Requests);
     advertise("loop", "LOOP_CLOSURE");
     advertise("graph", "POSE_GRAPH");
+    advertise("map", "MAP_UPDATE");
   }
 
   std::vector<std::string> writeProducts(const std::string& out_dir) override {
-    namespace fs = std::filesystem;
-    const std::string trajectory = (fs::path(out_dir) / "trajectory.tum").string();
-    const std::string map = (fs::path(out_dir) / "map.pcd").string();
-    const std::string graph = (fs::path(out_dir) / "pose_graph.g2o").string();
-    eval::writeTum(trajectory, closer_.correctedTrajectory(uncorrected_));
-    std::vector<LidarPoint> points;
-    for (const auto& p : closer_.correctedMap(map_voxel_)) points.push_back({p, 0.0f, 0, 0.0f});
-    io::writePcd(map, points);
-    saveG2o(closer_.graph(), graph);
-    return {trajectory, map, graph};
+    return writeMapProducts(closer_, uncorrected_, map_voxel_, out_dir);
+  }
+
+  void useRunFolder(const runtime::RunFolder& folder) override {
+    state_.setFolder(folder);
+    std::string error;
+    if (state_.resume([this](const std::string& bytes) { return restore(bytes); }, error)) {
+      setCount("restarted", 1);
+      setCount("recovered_keyframes", closer_.stats().keyframes);
+      setCount("recovered_loops", static_cast<std::int64_t>(closer_.acceptedLoops().size()));
+      spdlog::info("[loop_closer] resumed from {}: {} keyframes, {} loops, {} sweeps", state_.checkpointPath(),
+                   closer_.stats().keyframes, closer_.acceptedLoops().size(), uncorrected_.size());
+    } else if (!error.empty()) {
+      reportError("checkpoint_refused", error);
+    }
+  }
+
+  std::string state() const override { return health().counters.count("restarted") ? "restarted" : "running"; }
+
+ protected:
+  void onFinish() override {
+    if (!state_.live()) return;  // replay writes its products itself
+    saveProducts({});  // first: what the user asked for, before the stop's grace time runs out
+    checkpoint();
+    state_.flush();
+    reportCheckpoints();
   }
 
  private:
@@ -51,7 +93,11 @@ class LoopCloserNode : public runtime::Node, public WritesProducts {
       publish("loop", out);
     }
     if (result.graph_updated) publishGraph(mapped.utime, result);
+    if (const auto update = updates_.update(mapped.utime, closer_)) publishMapUpdate(*update);
     const LoopCloserStats& s = closer_.stats();
+    const bool periodic = result.keyframe_added && checkpoint_keyframes_ > 0 && s.keyframes % checkpoint_keyframes_ == 0;
+    if (state_.live() && (periodic || result.graph_updated)) checkpoint();
+    if (state_.live()) reportCheckpoints();
     setCount("keyframes", s.keyframes);
     setCount("loop_candidates", s.candidates);
     setCount("loops_accepted", s.accepted);
@@ -61,6 +107,100 @@ class LoopCloserNode : public runtime::Node, public WritesProducts {
     setCount("rejected_pairwise", s.rejected_pairwise);
     setCount("invalid_sweeps", s.invalid_sweeps);
   }
+
+  // save_map [NAME]: the corrected map, trajectory and graph into the run folder, as NAME.pcd / .tum / .g2o
+  // (default map.pcd, trajectory.tum, pose_graph.g2o). NAME must be a plain file name: a command comes from
+  // anyone on the bus, and must not choose where the process writes.
+  void onCommand(const adit::command_t& m) {
+    if (m.command != "save_map") {
+      reportError("unknown_command", "unknown command '" + printable(m.command) + "' (known: save_map)");
+      return;
+    }
+    if (!m.argument.empty()) {
+      const std::string problem = runtime::plainFileNameProblem(m.argument);
+      if (!problem.empty()) {
+        reportError("command_refused", "save_map '" + printable(m.argument) + "' refused: " + problem +
+                                           " (files go into the run folder " + state_.folder().dir + ")");
+        return;
+      }
+    }
+    saveProducts(productNamesFor(m.argument));
+  }
+
+  void saveProducts(const MapProductNames& names) {
+    try {
+      writeMapProducts(closer_, uncorrected_, map_voxel_, state_.folder().dir, names);
+      count("maps_saved");
+      spdlog::info("[loop_closer] saved {} keyframes, {} loops: {}, {}, {} in {}", closer_.stats().keyframes,
+                   closer_.acceptedLoops().size(), names.map, names.trajectory, names.graph, state_.folder().dir);
+    } catch (const std::exception& e) {
+      reportError("save_failed", std::string("save_map: ") + e.what());
+    }
+  }
+
+  // Keyframes go to an append-only log (each written once); the checkpoint holds the rest and how many
+  // keyframes it covers, so a checkpoint costs the new keyframes plus the graph, not the whole run. Both are
+  // written on the writer thread (a slow disk must not stall loop detection); a job superseded before it
+  // ran is covered by the next, which carries every keyframe the log does not hold yet.
+  void checkpoint() {
+    const std::size_t first = keyframes_written_->load();
+    std::vector<std::string> records;
+    for (std::size_t k = first; k < closer_.keyframes().size(); ++k)
+      records.push_back(closer_.keyframeRecord(static_cast<int>(k)));
+    ByteWriter w;
+    w.putString(closer_.saveState());
+    w.put<std::uint64_t>(uncorrected_.size());
+    for (const StampedPose& p : uncorrected_) {
+      w.put<std::int64_t>(p.utime);
+      w.putPose(p.pose);
+    }
+    state_.submit([this, first, records = std::move(records), payload = w.bytes()] {
+      try {
+        if (!keyframes_log_.isOpen()) keyframes_log_.create(keyframesPath(), kKeyframesKind, state_.folder().run_id);
+        if (first > keyframes_log_.size()) return std::string("keyframe log behind its checkpoint");
+        keyframes_log_.append({records.begin() + static_cast<std::ptrdiff_t>(keyframes_log_.size() - first), records.end()});
+        keyframes_written_->store(keyframes_log_.size());
+      } catch (const std::exception& e) {
+        return std::string("keyframes not written: ") + e.what();  // the previous checkpoint still matches
+      }
+      return state_.save(payload);
+    });
+  }
+
+  void reportCheckpoints() {
+    for (const std::string& e : state_.takeErrors()) reportError("checkpoint_failed", e);
+    setCount("checkpoints", state_.saved());
+  }
+
+  std::string restore(const std::string& bytes) {
+    ByteReader r(bytes);
+    const std::string state = r.getString();
+    Trajectory uncorrected(r.getCount(8 + 96));
+    for (StampedPose& p : uncorrected) {
+      p.utime = r.get<std::int64_t>();
+      p.pose = r.getPose();
+    }
+    if (!r.ok() || !r.atEnd()) return "malformed checkpoint";
+    const std::size_t n = LoopCloser::keyframesInState(state);
+    const runtime::LoadedRecords records = runtime::loadRecords(keyframesPath(), kKeyframesKind, state_.folder().run_id, n);
+    if (!records.error.empty()) return records.error;
+    if (records.records.size() < n)
+      return keyframesPath() + " holds " + std::to_string(records.records.size()) + " of the " + std::to_string(n) +
+             " keyframes the checkpoint names";
+    LoopCloser closer(closer_.config());
+    if (!closer.restoreState(state, records.records)) return "malformed loop closer state";
+    try {
+      keyframes_log_.continueAfter(keyframesPath(), n);  // cut keyframes written after the checkpoint
+      keyframes_written_->store(n);
+    } catch (const std::exception& e) {
+      return e.what();
+    }
+    closer_ = std::move(closer);
+    uncorrected_ = std::move(uncorrected);
+    return "";
+  }
+
+  std::string keyframesPath() const { return state_.folder().file("loop_closer.keyframes"); }
 
   void publishGraph(std::int64_t utime, const LoopCloser::Result& result) {
     adit::pose_graph_t g;
@@ -79,8 +219,40 @@ class LoopCloserNode : public runtime::Node, public WritesProducts {
     publish("graph", g);
   }
 
+  void publishMapUpdate(const MapUpdate& update) {
+    adit::map_update_t m;
+    m.header = msg::makeHeader(update.utime, "world");
+    m.num_submaps = update.num_submaps;
+    m.num_loops = update.num_loops;
+    for (const NewSubmap& s : update.added) {
+      adit::map_submap_t sub;
+      sub.id = s.where.id;
+      sub.utime = s.where.utime;
+      splitPose(s.where.pose, sub.position, sub.orientation);
+      sub.num_points = static_cast<std::int32_t>(s.points.size());
+      for (const Eigen::Vector3f& p : s.points) sub.points.push_back({p.x(), p.y(), p.z()});
+      m.new_submaps.push_back(std::move(sub));
+    }
+    m.num_new = static_cast<std::int32_t>(m.new_submaps.size());
+    for (const SubmapPose& s : update.moved) {
+      m.moved_id.push_back(s.id);
+      std::vector<double> position(3), orientation(4);
+      splitPose(s.pose, position.data(), orientation.data());
+      m.moved_position.push_back(position);
+      m.moved_orientation.push_back(orientation);
+    }
+    m.num_moved = static_cast<std::int32_t>(m.moved_id.size());
+    count("map_update_submaps", static_cast<std::int64_t>(update.added.size()));
+    publish("map", m);
+  }
+
   LoopCloser closer_;
   double map_voxel_;
+  int checkpoint_keyframes_;
+  MapUpdateTracker updates_;
+  runtime::RecordLog keyframes_log_;  // the writer thread's, once the run started
+  std::shared_ptr<std::atomic<std::size_t>> keyframes_written_ = std::make_shared<std::atomic<std::size_t>>(0);
+  RunState state_;  // after what its jobs use: its writer thread stops first
   Trajectory uncorrected_;
 };
 

@@ -1,5 +1,6 @@
 #include "nodes/mapper_node.hpp"
 
+#include "core/byte_codec.hpp"
 #include "core/geometry.hpp"
 #include "eval/trajectory_io.hpp"
 #include "io/pcd.hpp"
@@ -7,8 +8,8 @@
 #include "mapping/scan_to_map.hpp"
 #include "msg/convert.hpp"
 #include "nodes/products.hpp"
+#include "nodes/run_state.hpp"
 
-#include <adit/command_t.hpp>
 #include <adit/pose_graph_t.hpp>
 #include <spdlog/spdlog.h>
 
@@ -22,32 +23,55 @@ class MapperNode : public runtime::Node, public WritesProducts {
   explicit MapperNode(const Config& config)
       : Node("mapper"), mapper_(mapperConfigFrom(config)),
         map_voxel_(config.get<double>("mapping.node.map_voxel", 0.1)),
-        map_path_(config.get<std::string>("mapping.node.map_path", "")),
         // ODOM_MAPPED carries the sweep for the loop closer's keyframes, which it thins to 0.2 m itself
         // (loop.keyframe_voxel); keep this at or below that. 0 = forward it whole.
-        forward_voxel_(config.get<double>("mapping.node.forward_cloud_voxel", 0.2)) {
+        forward_voxel_(config.get<double>("mapping.node.forward_cloud_voxel", 0.2)),
+        // Sensor seconds between checkpoints of the local map (live runs only). 0 = only on stop.
+        checkpoint_period_us_(toUtime(config.get<double>("mapping.node.checkpoint_period_s", 2.0))),
+        state_("mapper") {
     subscribe<adit::odometry_t>("odometry", "ODOM_SCAN", [this](const adit::odometry_t& m) { onOdometry(m); });
     subscribe<adit::pose_graph_t>("graph", "POSE_GRAPH", [this](const adit::pose_graph_t& m) { onGraph(m); },
                                   runtime::InputKind::Events);
-    subscribe<adit::command_t>("command", "MAPPER_COMMAND", [this](const adit::command_t& m) { onCommand(m); },
-                               runtime::InputKind::Requests);
     advertise("mapped", "ODOM_MAPPED");
   }
 
+  // Replay only (live, the loop closer owns the map): odometry.tum, trajectory.tum and the mapper's own
+  // uncorrected map.pcd, both of which the loop closer, when it runs, replaces with its corrected ones.
   std::vector<std::string> writeProducts(const std::string& out_dir) override {
     namespace fs = std::filesystem;
     const std::string odometry = (fs::path(out_dir) / "odometry.tum").string();
     const std::string trajectory = (fs::path(out_dir) / "trajectory.tum").string();
     const std::string map = (fs::path(out_dir) / "map.pcd").string();
     eval::writeTum(odometry, uncorrected_);
-    eval::writeTum(trajectory, corrected_);  // the loop closer, when it runs, rewrites it from its graph
-    saveMap(map);
+    eval::writeTum(trajectory, corrected_);
+    std::vector<LidarPoint> points;
+    for (const auto& p : mapper_.globalMap(map_voxel_)) points.push_back({p, 0.0f, 0, 0.0f});
+    io::writePcd(map, points);
     return {odometry, trajectory, map};
   }
 
+  void useRunFolder(const runtime::RunFolder& folder) override {
+    state_.setFolder(folder);
+    std::string error;
+    if (state_.resume([this](const std::string& bytes) { return restore(bytes); }, error)) {
+      const ScanToMapMapper::State s = mapper_.state();
+      setCount("restarted", 1);
+      setCount("recovered_map_points", static_cast<std::int64_t>(s.corners.size() + s.surfs.size()));
+      spdlog::info("[mapper] resumed from {}: local map of {} points, last sweep at {}", state_.checkpointPath(),
+                   s.corners.size() + s.surfs.size(), s.utime);
+    } else if (!error.empty()) {
+      reportError("checkpoint_refused", error);
+    }
+  }
+
+  std::string state() const override { return health().counters.count("restarted") ? "restarted" : "running"; }
+
  protected:
   void onFinish() override {
-    if (!map_path_.empty()) saveMap(map_path_);
+    if (!state_.live()) return;
+    checkpoint();
+    state_.flush();
+    reportCheckpoints();
   }
 
  private:
@@ -65,45 +89,68 @@ class MapperNode : public runtime::Node, public WritesProducts {
     adit::odometry_t out = msg::toMessage(mapped, &features);
     splitPose(applied_, out.loop_correction_position, out.loop_correction_orientation);
     publish("mapped", out);
-    corrected_.push_back({mapped.utime, mapped.pose});
-    uncorrected_.push_back({mapped.utime, applied_.inverse() * mapped.pose});
+    if (!state_.live()) {  // the per-sweep trajectories are replay's products only
+      corrected_.push_back({mapped.utime, mapped.pose});
+      uncorrected_.push_back({mapped.utime, applied_.inverse() * mapped.pose});
+    }
+    if (state_.live() && checkpoint_period_us_ > 0 && mapped.utime - last_checkpoint_utime_ >= checkpoint_period_us_) {
+      checkpoint();
+      last_checkpoint_utime_ = mapped.utime;
+    }
+    reportCheckpoints();
   }
 
   // The graph's correction is total (relative to uncorrected poses); apply what is new to us.
   void onGraph(const adit::pose_graph_t& m) {
     const Eigen::Isometry3d total = makePose(m.correction_position, m.correction_orientation);
+    if (!total.matrix().allFinite()) {
+      reportDrop("invalid_graph", "POSE_GRAPH with a non-finite correction: skipped");
+      return;
+    }
     mapper_.applyCorrection(total * applied_.inverse());
     applied_ = total;
     count("loop_corrections");
   }
 
-  void onCommand(const adit::command_t& m) {
-    if (m.command == "save_map") {
-      saveMap(m.argument.empty() ? map_path_ : m.argument);
-    } else {
-      reportError("unknown_command", "unknown command '" + m.command + "' (known: save_map)");
-    }
+  void checkpoint() {
+    const ScanToMapMapper::State s = mapper_.state();
+    ByteWriter w;
+    w.put<std::int64_t>(s.utime);
+    w.putPose(s.T_map_odom);
+    w.putPose(s.previous_odometry);
+    w.putPose(applied_);
+    w.putPoints(s.corners);
+    w.putPoints(s.surfs);
+    state_.saveLater(w.bytes());
   }
 
-  void saveMap(const std::string& path) {
-    if (path.empty()) {
-      reportError("save_failed", "save_map: no path given and mapping.node.map_path is not set");
-      return;
-    }
-    std::vector<LidarPoint> points;
-    for (const auto& p : mapper_.globalMap(map_voxel_)) points.push_back({p, 0.0f, 0, 0.0f});
-    try {
-      io::writePcd(path, points);
-      spdlog::info("[mapper] saved map ({} points) to {}", points.size(), path);
-    } catch (const std::exception& e) {
-      reportError("save_failed", e.what());
-    }
+  void reportCheckpoints() {
+    for (const std::string& e : state_.takeErrors()) reportError("checkpoint_failed", e);
+    setCount("checkpoints", state_.saved());
+  }
+
+  std::string restore(const std::string& bytes) {
+    ByteReader r(bytes);
+    ScanToMapMapper::State s;
+    s.utime = r.get<std::int64_t>();
+    s.T_map_odom = r.getPose();
+    s.previous_odometry = r.getPose();
+    const Eigen::Isometry3d applied = r.getPose();
+    s.corners = r.getPoints<Eigen::Vector3d>();
+    s.surfs = r.getPoints<Eigen::Vector3d>();
+    if (!r.ok() || !r.atEnd()) return "malformed mapper state";
+    mapper_.restore(s);
+    applied_ = applied;
+    last_checkpoint_utime_ = s.utime;
+    return "";
   }
 
   ScanToMapMapper mapper_;
   double map_voxel_;
-  std::string map_path_;
   double forward_voxel_;
+  std::int64_t checkpoint_period_us_;
+  std::int64_t last_checkpoint_utime_ = -1;
+  RunState state_;
   Eigen::Isometry3d applied_ = Eigen::Isometry3d::Identity();  // total loop correction applied so far
   Trajectory corrected_, uncorrected_;
 };

@@ -1,10 +1,15 @@
 #include "nodes/odometry_node.hpp"
 
+#include "core/byte_codec.hpp"
 #include "features/preprocess.hpp"
 #include "msg/convert.hpp"
 #include "nodes/imu_buffer.hpp"
+#include "nodes/run_state.hpp"
 #include "odometry/initial_guess.hpp"
+#include "odometry/pose_increment.hpp"
 #include "odometry/scan_to_scan.hpp"
+
+#include <spdlog/spdlog.h>
 
 #include <deque>
 #include <optional>
@@ -18,26 +23,64 @@ class OdometryNode : public runtime::Node {
       : Node("odometry"),
         odometry_(scanToScanConfigFrom(config)),
         guess_config_(initialGuessConfigFrom(config)),
-        imu_(config.get<double>("odometry.node.imu_keep_s", 1.0)) {
+        imu_(config.get<double>("odometry.node.imu_keep_s", 1.0)),
+        state_("odometry") {
     // The sweep forwarded on ODOM_SCAN feeds only the mapper's global map (itself at 0.1 m): thin it to
     // that resolution so the bus and the logs carry a third of the bytes. 0 = forward it whole.
     forward_voxel_ = config.get<double>("odometry.node.forward_cloud_voxel", 0.1);
+    // Sensor seconds between checkpoints of the pose (live runs only; a few hundred bytes each).
+    checkpoint_period_us_ = toUtime(config.get<double>("odometry.node.checkpoint_period_s", 0.5));
+    // After a gap in the input (a restart, a stalled stage) the pose continues at the last velocity for at
+    // most this long (s); beyond, it stays where it was.
+    max_extrapolation_s_ = config.get<double>("odometry.node.max_extrapolation_s", 5.0);
     subscribe<adit::features_t>("features", "FEATURES", [this](const adit::features_t& m) { onFeatures(m); });
     subscribe<adit::imu_t>("imu", "IMU", [this](const adit::imu_t& m) { imu_.add(m); });
     advertise("odometry", "ODOM_SCAN");
   }
 
+  void useRunFolder(const runtime::RunFolder& folder) override {
+    state_.setFolder(folder);
+    std::string error;
+    if (state_.resume([this](const std::string& bytes) { return restore(bytes); }, error)) {
+      setCount("restarted", 1);
+      spdlog::info("[odometry] resumed from {}: pose ({:.2f}, {:.2f}, {:.2f}) at {}", state_.checkpointPath(),
+                   resume_->pose.translation().x(), resume_->pose.translation().y(),
+                   resume_->pose.translation().z(), resume_->utime);
+    } else if (!error.empty()) {
+      reportError("checkpoint_refused", error);
+    }
+  }
+
+  std::string state() const override { return health().counters.count("restarted") ? "restarted" : "running"; }
+
  protected:
+  // A gap in the sweeps (the feature stage restarted, the sensor stalled): start registration over, but
+  // in the same odometry frame, from the last pose moved on at the last velocity. Never back to identity.
   void onTimeJump(const std::string& port) override {
-    // A gap in the sweeps (stalled sensor) resets nothing: the odometry carries its averaged velocity across
-    // it and registers against the last sweep (resetting to the identity made the mapper jump back by the
-    // whole distance travelled).
+    if (port == "features") {
+      if (odometry_.lastUtime() >= 0) resume_ = Resume{odometry_.lastUtime(), odometry_.pose(), odometry_.lastVelocity()};
+      odometry_.reset();
+      previous_.reset();
+    }
     if (port == "imu") imu_.clear();
   }
 
+  void onFinish() override {
+    if (state_.live() && odometry_.lastUtime() >= 0) checkpoint();
+    state_.flush();
+    reportCheckpoints();
+  }
+
  private:
+  struct Resume {
+    std::int64_t utime = 0;
+    Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+    Vector6d velocity = Vector6d::Zero();
+  };
+
   void onFeatures(const adit::features_t& m) {
     FeatureSet features = msg::fromMessage(m);
+    if (resume_) resumeFrom(*resume_, features.utime);
     const std::vector<ImuSample> imu = imu_.samples();
     const InitialGuess guess = initialGuess(previous_ ? &*previous_ : nullptr, features,
                                             odometry_.predictMotion(features.utime), imu, guess_config_);
@@ -55,12 +98,55 @@ class OdometryNode : public runtime::Node {
       features.cloud.points = features::voxelDownsample(features.cloud.points, static_cast<float>(forward_voxel_));
     adit::odometry_t out = msg::toMessage(pose, &features);
     publish("odometry", out);
+    if (state_.live() && pose.utime - last_checkpoint_utime_ >= checkpoint_period_us_) checkpoint();
+    reportCheckpoints();
+  }
+
+  void resumeFrom(const Resume& r, std::int64_t utime) {
+    const double gap_s = toSeconds(utime - r.utime);
+    Eigen::Isometry3d pose = r.pose;
+    if (gap_s > 0 && gap_s <= max_extrapolation_s_) pose = applyIncrement(r.pose, r.velocity * gap_s);
+    odometry_.resumeAt(pose);
+    previous_.reset();
+    resume_.reset();
+    count("resumed");
+  }
+
+  void checkpoint() {
+    ByteWriter w;
+    w.put<std::int64_t>(odometry_.lastUtime());
+    w.putPose(odometry_.pose());
+    w.putMatrix(odometry_.lastVelocity());
+    state_.saveLater(w.bytes());
+    last_checkpoint_utime_ = odometry_.lastUtime();
+  }
+
+  void reportCheckpoints() {
+    for (const std::string& e : state_.takeErrors()) reportError("checkpoint_failed", e);
+    setCount("checkpoints", state_.saved());
+  }
+
+  std::string restore(const std::string& bytes) {
+    ByteReader r(bytes);
+    Resume resume;
+    resume.utime = r.get<std::int64_t>();
+    resume.pose = r.getPose();
+    resume.velocity = r.getMatrix<Vector6d>();
+    if (!r.ok() || !r.atEnd() || !resume.velocity.allFinite()) return "malformed odometry state";
+    resume_ = resume;
+    last_checkpoint_utime_ = resume.utime;
+    return "";
   }
 
   ScanToScanOdometry odometry_;
   InitialGuessConfig guess_config_;
   ImuBuffer imu_;
   double forward_voxel_ = 0.1;
+  std::int64_t checkpoint_period_us_ = 500000;
+  double max_extrapolation_s_ = 5.0;
+  std::int64_t last_checkpoint_utime_ = -1;
+  RunState state_;
+  std::optional<Resume> resume_;
   std::optional<FeatureSet> previous_;
 };
 

@@ -61,6 +61,15 @@ ScanToScanOdometry::ScanToScanOdometry(ScanToScanConfig config) : config_(std::m
 
 void ScanToScanOdometry::reset() { *this = ScanToScanOdometry(config_); }
 
+Vector6d ScanToScanOdometry::lastVelocity() const {
+  if (last_gap_us_ <= 0) return Vector6d::Zero();
+  return incrementBetween(Eigen::Isometry3d::Identity(), last_motion_) / toSeconds(last_gap_us_);
+}
+
+void ScanToScanOdometry::resumeAt(const Eigen::Isometry3d& pose) {
+  reset();
+  if (pose.matrix().allFinite()) pose_ = pose;
+}
 
 bool ScanToScanOdometry::hasVelocity(std::int64_t utime) const {
   const std::int64_t gap = utime - previous_utime_;

@@ -9,6 +9,7 @@
 
 #include "msg/encode.hpp"
 #include "runtime/health.hpp"
+#include "runtime/run_folder.hpp"
 
 #include <cstdint>
 #include <functional>
@@ -61,6 +62,10 @@ class Node {
   TimingWindow& timing() { return timing_; }
   // A short word for STATUS ("running", "behind", ...); subclasses may refine it.
   virtual std::string state() const { return "running"; }
+
+  // Where this run's files go (products, checkpoints); called once before the first input. Live processes
+  // pass RunFolder::live = true: a stage may then resume from its checkpoint and save on stop.
+  virtual void useRunFolder(const RunFolder& /*folder*/) {}
 
   // Forward gaps in sensor time above this are counted as "time_jump" and reported to onTimeJump().
   void setMaxTimeGap(double seconds) { max_time_gap_us_ = static_cast<std::int64_t>(seconds * 1e6); }

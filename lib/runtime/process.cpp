@@ -65,6 +65,8 @@ void addProcessOptions(CLI::App& app, ProcessOptions& o) {
                  "which launch/config/pipeline.yaml lists)");
   app.add_option("--channel", o.channel_remaps, "Rename a channel: PORT=CHANNEL (repeatable)");
   app.add_option("--status-period", o.status_period_s, "Seconds between STATUS messages")->check(CLI::PositiveNumber);
+  app.add_option("--run-dir", o.run_dir,
+                 "Run folder for the files commands ask for and for checkpoints (default: $ADIT_RUN_DIR, else .)");
   app.add_option("--status-channel", o.status_channel, "STATUS channel (default STATUS_<process>)");
 }
 
@@ -100,6 +102,7 @@ int runNodeProcess(int argc, char** argv, const std::string& name, const std::st
   try {
     node = factory(loadConfig(options.config_paths));
     applyRemaps(*node, options.channel_remaps);
+    node->useRunFolder(liveRunFolder(options.run_dir));
   } catch (const std::exception& e) {
     spdlog::error("{}", e.what());
     return 2;

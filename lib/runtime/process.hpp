@@ -23,6 +23,7 @@ struct ProcessOptions {
   std::vector<std::string> channel_remaps;  // PORT=CHANNEL
   double status_period_s = 1.0;
   std::string status_channel;  // "" = STATUS_<NAME>
+  std::string run_dir;  // "" = $ADIT_RUN_DIR, else "." (runtime/run_folder.hpp)
 };
 
 void addProcessOptions(CLI::App& app, ProcessOptions& options);

@@ -1,0 +1,156 @@
+// LoopCloser state <-> bytes, for checkpoints: everything process() depends on, so a restored loop closer
+// continues exactly as the one that wrote the checkpoint would have (same keyframes, graph, pending loops).
+#include "core/byte_codec.hpp"
+#include "loop/loop_closer.hpp"
+
+namespace adit {
+namespace {
+
+void putLoop(ByteWriter& w, const LoopConstraint& l) {
+  w.put<std::int32_t>(l.query_index);
+  w.put<std::int32_t>(l.match_index);
+  w.put<std::int64_t>(l.query_utime);
+  w.put<std::int64_t>(l.match_utime);
+  w.putPose(l.T_match_query);
+  w.putMatrix(l.information);
+  for (double v : {l.scan_context_distance, l.scan_context_yaw, l.fitness, l.inlier_ratio}) w.put<double>(v);
+}
+
+LoopConstraint getLoop(ByteReader& r) {
+  LoopConstraint l;
+  l.query_index = r.get<std::int32_t>();
+  l.match_index = r.get<std::int32_t>();
+  l.query_utime = r.get<std::int64_t>();
+  l.match_utime = r.get<std::int64_t>();
+  l.T_match_query = r.getPose();
+  l.information = r.getMatrix<Matrix6d>();
+  l.scan_context_distance = r.get<double>();
+  l.scan_context_yaw = r.get<double>();
+  l.fitness = r.get<double>();
+  l.inlier_ratio = r.get<double>();
+  return l;
+}
+
+constexpr std::size_t kLoopBytes = 4 + 4 + 8 + 8 + 96 + 288 + 32;
+
+void putLoops(ByteWriter& w, const std::vector<LoopConstraint>& loops) {
+  w.put<std::uint64_t>(loops.size());
+  for (const LoopConstraint& l : loops) putLoop(w, l);
+}
+
+std::vector<LoopConstraint> getLoops(ByteReader& r, int keyframes) {
+  std::vector<LoopConstraint> loops(r.getCount(kLoopBytes));
+  for (LoopConstraint& l : loops) {
+    l = getLoop(r);
+    if (l.query_index < 0 || l.query_index >= keyframes || l.match_index < 0 || l.match_index >= keyframes) r.fail();
+  }
+  return loops;
+}
+
+// Every counter of LoopCloserStats, in declaration order.
+std::vector<int*> statFields(LoopCloserStats& s) {
+  return {&s.sweeps, &s.invalid_sweeps, &s.keyframes, &s.queries, &s.candidates, &s.rejected_fitness,
+          &s.rejected_degenerate, &s.rejected_odometry, &s.rejected_pairwise, &s.pending, &s.accepted,
+          &s.optimizations};
+}
+
+}  // namespace
+
+std::string LoopCloser::keyframeRecord(int k) const {
+  ByteWriter w;
+  const Keyframe& kf = keyframes_[static_cast<std::size_t>(k)];
+  w.put<std::int64_t>(kf.utime);
+  w.putPose(kf.uncorrected);
+  w.putPoints(kf.cloud);
+  const ScanContext& sc = database_.context(k);
+  w.put<std::int32_t>(sc.rings());
+  w.put<std::int32_t>(sc.sectors());
+  w.put<std::int32_t>(sc.shiftSearchRadius());
+  w.putMatrix(sc.descriptor());
+  w.putMatrix(chain_.stepCovariance(k));
+  return w.bytes();
+}
+
+std::string LoopCloser::saveState() const {
+  ByteWriter w;
+  w.put<std::uint64_t>(keyframes_.size());
+  for (int k = 0; k < graph_.size(); ++k) w.putPose(graph_.pose(k));
+  w.put<std::uint64_t>(graph_.edges().size());
+  for (const PoseGraphEdge& e : graph_.edges()) {
+    w.put<std::int32_t>(e.from);
+    w.put<std::int32_t>(e.to);
+    w.putPose(e.T_from_to);
+    w.putMatrix(e.information);
+    w.put<std::uint8_t>(e.robust ? 1 : 0);
+  }
+  putLoops(w, accepted_);
+  putLoops(w, pending_);
+  w.put<std::uint64_t>(sweeps_since_keyframe_.size());
+  for (const auto& [pose, covariance] : sweeps_since_keyframe_) {
+    w.putPose(pose);
+    w.putMatrix(covariance);
+  }
+  w.put<std::int32_t>(last_loop_query_);
+  LoopCloserStats stats = stats_;
+  for (int* field : statFields(stats)) w.put<std::int32_t>(*field);
+  return w.bytes();
+}
+
+std::size_t LoopCloser::keyframesInState(const std::string& state) {
+  ByteReader r(state);
+  const auto n = r.getCount(96);
+  return r.ok() ? n : 0;
+}
+
+bool LoopCloser::restoreState(const std::string& state, const std::vector<std::string>& keyframe_records) {
+  ByteReader r(state);
+  LoopCloser restored(config_);
+  const auto n = r.getCount(96);  // a graph pose per keyframe
+  if (!r.ok() || keyframe_records.size() < n) return false;
+  for (std::uint64_t k = 0; k < n && r.ok(); ++k) {
+    const std::string& record = keyframe_records[k];
+    ByteReader kr(record);
+    Keyframe kf;
+    kf.utime = kr.get<std::int64_t>();
+    kf.uncorrected = kr.getPose();
+    kf.cloud = kr.getPoints<Eigen::Vector3f>();
+    const int rings = kr.get<std::int32_t>(), sectors = kr.get<std::int32_t>(), radius = kr.get<std::int32_t>();
+    if (!kr.ok() || rings <= 0 || sectors <= 0 || rings > 1000 || sectors > 1000 ||
+        static_cast<std::uint64_t>(rings) * static_cast<std::uint64_t>(sectors) * 4 > record.size())
+      return false;
+    Eigen::MatrixXf descriptor(rings, sectors);
+    for (int i = 0; i < rings; ++i)
+      for (int j = 0; j < sectors; ++j) descriptor(i, j) = kr.get<float>();
+    const Matrix6d step = kr.getMatrix<Matrix6d>();
+    if (!kr.ok() || !kr.atEnd()) return false;
+    restored.chain_.add(kf.uncorrected, step);
+    restored.graph_.addNode(r.getPose());
+    restored.database_.add(ScanContext::fromDescriptor(descriptor, radius), kf.utime);
+    restored.keyframes_.push_back(std::move(kf));
+  }
+  const auto edges = r.getCount(4 + 4 + 96 + 288 + 1);
+  for (std::uint64_t i = 0; i < edges && r.ok(); ++i) {
+    PoseGraphEdge e;
+    e.from = r.get<std::int32_t>();
+    e.to = r.get<std::int32_t>();
+    e.T_from_to = r.getPose();
+    e.information = r.getMatrix<Matrix6d>();
+    e.robust = r.get<std::uint8_t>() != 0;
+    if (r.ok() && !restored.graph_.addEdge(e)) r.fail();
+  }
+  const int keyframes = static_cast<int>(restored.keyframes_.size());
+  restored.accepted_ = getLoops(r, keyframes);
+  restored.pending_ = getLoops(r, keyframes);
+  const auto sweeps = r.getCount(96 + 288);
+  for (std::uint64_t i = 0; i < sweeps && r.ok(); ++i) {
+    const Eigen::Isometry3d pose = r.getPose();
+    restored.sweeps_since_keyframe_.emplace_back(pose, r.getMatrix<Matrix6d>());
+  }
+  restored.last_loop_query_ = r.get<std::int32_t>();
+  for (int* field : statFields(restored.stats_)) *field = r.get<std::int32_t>();
+  if (!r.ok() || !r.atEnd()) return false;
+  *this = std::move(restored);
+  return true;
+}
+
+}  // namespace adit

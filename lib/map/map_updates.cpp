@@ -1,0 +1,51 @@
+#include "map/map_updates.hpp"
+
+#include "core/geometry.hpp"
+#include "loop/voxel_filter.hpp"
+
+namespace adit {
+
+MapUpdateConfig mapUpdateConfigFrom(const Config& c) {
+  MapUpdateConfig m;
+  m.period_s = c.get<double>("map.update_period_s", m.period_s);
+  m.voxel_m = c.get<double>("map.update_voxel_m", m.voxel_m);
+  m.move_threshold_m = c.get<double>("map.update_move_m", m.move_threshold_m);
+  m.move_threshold_deg = c.get<double>("map.update_move_deg", m.move_threshold_deg);
+  m.max_points = c.get<int>("map.update_max_points", m.max_points);
+  m.max_moved = c.get<int>("map.update_max_moved", m.max_moved);
+  return m;
+}
+
+std::optional<MapUpdate> MapUpdateTracker::update(std::int64_t utime, const LoopCloser& closer) {
+  if (last_utime_ >= 0 && utime - last_utime_ < toUtime(config_.period_s)) return std::nullopt;
+  const auto& keyframes = closer.keyframes();
+  const PoseGraph& graph = closer.graph();
+  MapUpdate out;
+  out.utime = utime;
+  out.num_submaps = static_cast<int>(keyframes.size());
+  out.num_loops = static_cast<int>(closer.acceptedLoops().size());
+  const double max_angle = config_.move_threshold_deg * 3.14159265358979323846 / 180.0;
+  for (std::size_t k = 0; k < sent_.size() && static_cast<int>(out.moved.size()) < config_.max_moved; ++k) {
+    const Eigen::Isometry3d& now = graph.pose(static_cast<int>(k));
+    const Eigen::Isometry3d delta = sent_[k].inverse() * now;
+    if (translationNorm(delta) < config_.move_threshold_m && rotationAngle(delta) < max_angle) continue;
+    out.moved.push_back({static_cast<int>(k), keyframes[k].utime, now});
+    sent_[k] = now;
+  }
+  std::size_t points = 0;
+  while (sent_.size() < keyframes.size()) {
+    const std::size_t k = sent_.size();
+    std::vector<Eigen::Vector3f> decimated = voxelDownsample(keyframes[k].cloud, config_.voxel_m);
+    // Always at least one submap per update, so a huge one cannot stall the stream.
+    if (!out.added.empty() && points + decimated.size() > static_cast<std::size_t>(config_.max_points)) break;
+    points += decimated.size();
+    const Eigen::Isometry3d pose = graph.pose(static_cast<int>(k));
+    out.added.push_back({{static_cast<int>(k), keyframes[k].utime, pose}, std::move(decimated)});
+    sent_.push_back(pose);
+  }
+  if (out.added.empty() && out.moved.empty()) return std::nullopt;
+  last_utime_ = utime;
+  return out;
+}
+
+}  // namespace adit

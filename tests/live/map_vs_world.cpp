@@ -1,0 +1,56 @@
+// map_vs_world <map.pcd> <world.pcd> <ground_truth.tum> <estimate.tum>: how far the points of a saved map
+// lie from the simulator's true surfaces. The map is in the estimate's frame (its first pose is the origin
+// of the run); it is placed in the world with the ground truth at that first instant. The world file is a
+// dense sampling of the surfaces (`adit sim --world-pcd`), so the nearest world point stands in for the
+// surface (bias below half the sampling spacing). Prints: points, mean distance (m), share beyond 0.2 m.
+#include "eval/trajectory_io.hpp"
+#include "io/pcd.hpp"
+#include "odometry/kdtree.hpp"
+
+#include <cmath>
+#include <cstdio>
+
+namespace {
+
+std::vector<Eigen::Vector3d> readPoints(const std::string& path) {
+  adit::io::PcdFolderConfig config;
+  const adit::LidarScan scan = adit::io::readPcdScan(path, config, 0, 0);
+  std::vector<Eigen::Vector3d> out;
+  for (const adit::LidarPoint& p : scan.points) out.push_back(p.p.cast<double>());
+  return out;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc != 5) {
+    std::fprintf(stderr, "usage: map_vs_world <map.pcd> <world.pcd> <ground_truth.tum> <estimate.tum>\n");
+    return 2;
+  }
+  try {
+    const adit::Trajectory gt = adit::eval::readTum(argv[3]), est = adit::eval::readTum(argv[4]);
+    if (gt.empty() || est.empty()) throw std::runtime_error("empty trajectory");
+    // Ground truth at the estimate's first stamp (nearest), and the estimate's own first pose.
+    const adit::StampedPose* g = &gt.front();
+    for (const auto& p : gt)
+      if (std::llabs(p.utime - est.front().utime) < std::llabs(g->utime - est.front().utime)) g = &p;
+    const Eigen::Isometry3d T_world_map = g->pose * est.front().pose.inverse();
+    const adit::KdTree3 world(readPoints(argv[2]));
+    const std::vector<Eigen::Vector3d> map = readPoints(argv[1]);
+    double sum = 0;
+    std::size_t far = 0;
+    for (const Eigen::Vector3d& p : map) {
+      const Eigen::Vector3d q = T_world_map * p;
+      const int i = world.nearest(q, 4.0);
+      const double d = i < 0 ? 2.0 : (world.point(i) - q).norm();
+      sum += d;
+      far += d > 0.2 ? 1 : 0;
+    }
+    const double n = static_cast<double>(std::max<std::size_t>(map.size(), 1));
+    std::printf("points=%zu mean_m=%.4f beyond_0.2m=%.4f\n", map.size(), sum / n, static_cast<double>(far) / n);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "map_vs_world: %s\n", e.what());
+    return 1;
+  }
+  return 0;
+}

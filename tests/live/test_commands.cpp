@@ -1,0 +1,88 @@
+// Commands are received from anyone on the bus: save_map may only name a plain file inside the run folder;
+// anything else is refused, counted and logged, and nothing is written.
+#include "node_harness.hpp"
+#include "nodes/registry.hpp"
+#include "runtime/run_folder.hpp"
+
+#include <adit/command_t.hpp>
+#include <gtest/gtest.h>
+
+namespace fs = std::filesystem;
+using adit::test::counter;
+
+namespace {
+
+adit::command_t command(const std::string& name, const std::string& argument) {
+  adit::command_t c;
+  c.header.utime = 0;
+  c.header.seq = 0;
+  c.command = name;
+  c.argument = argument;
+  return c;
+}
+
+std::size_t filesIn(const std::string& dir) {
+  std::size_t n = 0;
+  for (const auto& e : fs::recursive_directory_iterator(dir)) n += e.is_regular_file() ? 1 : 0;
+  return n;
+}
+
+TEST(Commands, SaveMapWritesTheThreeProductsIntoTheRunFolder) {
+  adit::test::TempFolder parent;
+  const std::string run = parent.file("run");
+  fs::create_directory(run);
+  auto node = adit::nodes::makeNode("loop_closer", adit::Config{});
+  node->useRunFolder(adit::test::liveFolder(run));
+  adit::test::Collector sink;
+  for (int k = 0; k < 5; ++k) adit::test::deliver(*node, "ODOM_MAPPED", adit::test::mappedMessage(k), sink);
+  adit::test::deliver(*node, "MAPPER_COMMAND", command("save_map", ""), sink);
+  adit::test::deliver(*node, "MAPPER_COMMAND", command("save_map", "before_loop.pcd"), sink);
+  for (const char* f : {"map.pcd", "trajectory.tum", "pose_graph.g2o", "before_loop.pcd", "before_loop.tum",
+                        "before_loop.g2o"})
+    EXPECT_TRUE(fs::exists(fs::path(run) / f)) << f;
+  EXPECT_EQ(counter(*node, "maps_saved"), 2);
+  EXPECT_GT(fs::file_size(fs::path(run) / "map.pcd"), 1000u);
+}
+
+TEST(Commands, HostilePathsAreRefusedAndCounted) {
+  adit::test::TempFolder parent;
+  const std::string run = parent.file("run");
+  fs::create_directory(run);
+  auto node = adit::nodes::makeNode("loop_closer", adit::Config{});
+  node->useRunFolder(adit::test::liveFolder(run));
+  adit::test::Collector sink;
+  adit::test::deliver(*node, "ODOM_MAPPED", adit::test::mappedMessage(0), sink);
+  const std::vector<std::string> hostile{
+      parent.file("evil.pcd"), "../evil.pcd", "../../etc/passwd", "sub/map.pcd", "..", ".", ".hidden", "-rf",
+      "a\\b", "map\n.pcd", std::string(65, 'a'), "m\xc3\xa9.pcd", "map .pcd",
+      "~root", "$HOME"};
+  // (A NUL cannot be sent: LCM strings end at the first one, so "map\0x" arrives as the harmless "map".)
+  for (const std::string& arg : hostile) adit::test::deliver(*node, "MAPPER_COMMAND", command("save_map", arg), sink);
+  EXPECT_EQ(counter(*node, "command_refused"), static_cast<std::int64_t>(hostile.size()));
+  EXPECT_EQ(counter(*node, "maps_saved"), 0);
+  EXPECT_EQ(filesIn(parent.path()), 0u) << "a refused command wrote a file";
+  EXPECT_NE(node->health().last_error.find("refused"), std::string::npos);
+  adit::test::deliver(*node, "MAPPER_COMMAND", command("rm", "-rf /"), sink);
+  EXPECT_EQ(counter(*node, "unknown_command"), 1);
+}
+
+TEST(Commands, PlainFileNameRules) {
+  using adit::runtime::plainFileNameProblem;
+  for (const char* ok : {"map.pcd", "run_2024-01-01.pcd", "a", "A.b.c"}) EXPECT_EQ(plainFileNameProblem(ok), "") << ok;
+  for (const char* bad : {"", "/map.pcd", "a/b", "..", "../x", ".x", "-x", "x y", "x;y"})
+    EXPECT_NE(plainFileNameProblem(bad), "") << bad;
+  EXPECT_NE(plainFileNameProblem(std::string(adit::runtime::kMaxCommandFileName + 1, 'a')), "");
+  EXPECT_EQ(plainFileNameProblem(std::string(adit::runtime::kMaxCommandFileName, 'a')), "");
+}
+
+TEST(Commands, AnUnwritableRunFolderIsAnErrorNotACrash) {
+  adit::test::TempFolder parent;
+  auto node = adit::nodes::makeNode("loop_closer", adit::Config{});
+  node->useRunFolder(adit::test::liveFolder(parent.file("missing/run")));
+  adit::test::Collector sink;
+  adit::test::deliver(*node, "ODOM_MAPPED", adit::test::mappedMessage(0), sink);
+  adit::test::deliver(*node, "MAPPER_COMMAND", command("save_map", ""), sink);
+  EXPECT_EQ(counter(*node, "save_failed"), 1);
+}
+
+}  // namespace
