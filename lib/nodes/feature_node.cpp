@@ -1,7 +1,9 @@
 #include "nodes/feature_node.hpp"
 
 #include "features/feature_extractor.hpp"
+#include "features/preprocess.hpp"
 #include "msg/convert.hpp"
+#include "msg/sweep_codec.hpp"
 #include "nodes/imu_buffer.hpp"
 
 #include <deque>
@@ -18,7 +20,11 @@ class FeatureNode : public runtime::Node {
         imu_(config.get<double>("features.node.imu_keep_s", 0.5)) {
     // An odometry pose older than this (s) before a sweep is too stale to predict its motion.
     max_prior_age_s_ = config.get<double>("features.node.max_prior_age_s", 0.3);
-    subscribe<adit::point_cloud_t>("points", "LIDAR_POINTS", [this](const adit::point_cloud_t& m) { onSweep(m); });
+    // FEATURES carries the sweep only thinned to this voxel (m): what the mapper's global map (0.1 m) and,
+    // thinned again, the loop closer's keyframes need. 0 = the whole preprocessed sweep (5x the bytes).
+    map_cloud_voxel_ = config.get<double>("features.node.map_cloud_voxel", 0.1);
+    // LIDAR_POINTS in either form: compact lidar_scan_t or the full-float point_cloud_t of older logs.
+    subscribe<msg::SweepMessage>("points", "LIDAR_POINTS", [this](const msg::SweepMessage& m) { onSweep(m); });
     subscribe<adit::imu_t>("imu", "IMU", [this](const adit::imu_t& m) { imu_.add(m); });
     subscribe<adit::odometry_t>("odometry", "ODOM_SCAN", [this](const adit::odometry_t& m) { onOdometry(m); });
     advertise("features", "FEATURES");
@@ -49,17 +55,24 @@ class FeatureNode : public runtime::Node {
     return prior;
   }
 
-  void onSweep(const adit::point_cloud_t& m) {
-    const LidarScan scan = msg::fromMessage(m);
+  void onSweep(const msg::SweepMessage& m) {
+    if (!m.error.empty()) {
+      reportError(m.unknown_version ? "unknown_format_version" : "invalid_sweep",
+                  "LIDAR_POINTS sweep at utime " + std::to_string(m.header.utime) + ": " + m.error + ": skipped");
+      return;
+    }
+    const LidarScan& scan = m.scan;
     if (scan.points.empty()) reportDrop("empty_scan", "sweep at utime " + std::to_string(scan.utime) + " has no points");
     const std::vector<ImuSample> imu = imu_.samples();
-    const FeatureSet features = extractor_.process(scan, imu, motionPrior(scan.utime));
+    FeatureSet features = extractor_.process(scan, imu, motionPrior(scan.utime));
     count("points_in", features.points_in);
     count("removed_invalid", features.removed_invalid);
     count("removed_range", features.removed_range);
     count("removed_outlier", features.removed_outlier);
     if (features.flags & FeatureSet::kFewKeypoints) count("few_keypoints");
     if (features.flags & FeatureSet::kEmptyRing) count("empty_ring");
+    if (map_cloud_voxel_ > 0)
+      features.cloud.points = features::voxelDownsample(features.cloud.points, static_cast<float>(map_cloud_voxel_));
     adit::features_t out = msg::toMessage(features);
     publish("features", out);
   }
@@ -67,6 +80,7 @@ class FeatureNode : public runtime::Node {
   FeatureExtractor extractor_;
   ImuBuffer imu_;
   double max_prior_age_s_ = 0.3;
+  double map_cloud_voxel_ = 0.1;
   std::deque<StampedPose> poses_;
 };
 

@@ -19,8 +19,8 @@ class OdometryNode : public runtime::Node {
         odometry_(scanToScanConfigFrom(config)),
         guess_config_(initialGuessConfigFrom(config)),
         imu_(config.get<double>("odometry.node.imu_keep_s", 1.0)) {
-    // The sweep forwarded on ODOM_SCAN feeds only the mapper's global map (itself at 0.1 m): thin it to
-    // that resolution so the bus and the logs carry a third of the bytes. 0 = forward it whole.
+    // The sweep forwarded on ODOM_SCAN feeds only the mapper's global map (itself at 0.1 m). FEATURES already
+    // carries it thinned (features.node.map_cloud_voxel); this thins it again only if set coarser. 0 = as is.
     forward_voxel_ = config.get<double>("odometry.node.forward_cloud_voxel", 0.1);
     subscribe<adit::features_t>("features", "FEATURES", [this](const adit::features_t& m) { onFeatures(m); });
     subscribe<adit::imu_t>("imu", "IMU", [this](const adit::imu_t& m) { imu_.add(m); });
@@ -49,7 +49,7 @@ class OdometryNode : public runtime::Node {
     if (pose.flags & PoseEstimate::kRegistrationFailed) count("registration_failed");
     if (pose.flags & PoseEstimate::kDegenerateTranslation) count("degenerate_translation");
     previous_ = features;
-    // Downstream needs neither the odometry-only sets nor the full-density sweep.
+    // The mapper needs the less-sharp / less-flat sets and the thinned sweep (odometry_t carries only those).
     features.corner_sharp.clear();
     features.surf_flat.clear();
     if (forward_voxel_ > 0)

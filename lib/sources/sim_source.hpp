@@ -3,6 +3,7 @@
 #pragma once
 
 #include "core/types.hpp"
+#include "msg/sweep_codec.hpp"
 #include "runtime/source.hpp"
 #include "sim/simulator.hpp"
 
@@ -14,8 +15,14 @@ struct SimChannels {
   std::string lidar = "LIDAR_POINTS";
   std::string imu = "IMU";
   std::string ground_truth = "GROUND_TRUTH";  // "" = do not publish
+  // false: sweeps as full-float point_cloud_t, the format of logs before lidar_scan_t (tests of old logs).
+  bool compact_sweeps = true;
 };
 
+// The simulated head's firing table (ring of slot k fires k * firing_slot after its column), for encodeSweep.
+msg::FiringTable firingTableOf(const sim::LidarProfile& profile);
+
+// LIDAR_POINTS as compact lidar_scan_t (firing-grid layout), IMU, GROUND_TRUTH (odometry_t, pose only).
 class SimSource : public runtime::MessageSource {
  public:
   SimSource(const sim::SimConfig& config, SimChannels channels);
@@ -30,6 +37,7 @@ class SimSource : public runtime::MessageSource {
  private:
   sim::Simulator simulator_;
   SimChannels channels_;
+  msg::FiringTable firing_table_;
   runtime::Health health_;
   Trajectory truth_;
   std::optional<runtime::OutgoingMessage> pending_truth_;  // published right after its sweep
