@@ -10,7 +10,8 @@ namespace adit::msg {
 namespace {
 
 constexpr double kTwoPi = 2.0 * M_PI;
-constexpr double kAzimuthUnit = kTwoPi / 65536.0;       // rad per column_azimuth / azimuth count
+constexpr double kAzimuthUnit = kTwoPi / 65536.0;       // rad per azimuth count (per-point layout)
+constexpr double kColumnAzimuthUnit = kTwoPi / 4294967296.0;  // rad per column_azimuth count
 constexpr double kElevationUnit = M_PI / 2.0 / 32767.0;  // rad per elevation count
 // Columns further apart in time than this belong to different firing sequences (a slot is >= 0.75 us).
 constexpr double kColumnTimeTolerance_ns = 300.0;
@@ -21,6 +22,11 @@ std::int16_t azimuthCount(double az) {
   double a = std::fmod(az, kTwoPi);
   if (a < 0) a += kTwoPi;
   return static_cast<std::int16_t>(static_cast<std::uint16_t>(std::lround(a / kAzimuthUnit) & 0xFFFF));
+}
+std::int32_t columnAzimuthCount(double az) {
+  double a = std::fmod(az, kTwoPi);
+  if (a < 0) a += kTwoPi;
+  return static_cast<std::int32_t>(static_cast<std::uint32_t>(std::llround(a / kColumnAzimuthUnit) & 0xFFFFFFFFLL));
 }
 double wrapPi(double a) { return a - kTwoPi * std::floor((a + M_PI) / kTwoPi); }
 
@@ -152,7 +158,7 @@ bool encodeGrid(const LidarScan& scan, const std::vector<LidarPoint>& points, co
   }
   // Points that fall in columns of their own (a table that is not this head's) make a grid larger than the
   // per-point layout (9 bytes a point): then it is no grid.
-  const std::size_t grid_bytes = columns.size() * (6 + 3 * static_cast<std::size_t>(beams));
+  const std::size_t grid_bytes = columns.size() * (8 + 3 * static_cast<std::size_t>(beams));
   if (grid_bytes >= 9 * points.size()) return false;
 
   fillCommon(scan, m);
@@ -169,7 +175,7 @@ bool encodeGrid(const LidarScan& scan, const std::vector<LidarPoint>& points, co
   m.range.assign(static_cast<std::size_t>(m.num_returns), 0);
   m.intensity.assign(static_cast<std::size_t>(m.num_returns), 0);
   for (std::size_t c = 0; c < columns.size(); ++c) {
-    m.column_azimuth.push_back(azimuthCount(columns[c].azimuth));
+    m.column_azimuth.push_back(columnAzimuthCount(columns[c].azimuth));
     m.column_time_ns.push_back(static_cast<std::int32_t>(std::lround(columns[c].time_ns)));
     for (int r = 0; r < beams; ++r) {
       const std::size_t i = columns[c].point_of_ring[r];
@@ -255,7 +261,7 @@ std::string decodeGrid(const adit::lidar_scan_t& m, LidarScan& s) {
   }
   s.points.reserve(static_cast<std::size_t>(m.num_returns));
   for (int c = 0; c < m.num_columns; ++c) {
-    const double az0 = fromU16(m.column_azimuth[c]) * kAzimuthUnit;
+    const double az0 = static_cast<double>(static_cast<std::uint32_t>(m.column_azimuth[c])) * kColumnAzimuthUnit;
     for (const int r : order) {
       const std::size_t k = static_cast<std::size_t>(c) * beams + static_cast<std::size_t>(r);
       if (m.range[k] == 0) continue;

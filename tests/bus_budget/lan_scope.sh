@@ -22,7 +22,7 @@ LOCAL='udpm://239.255.76.67:7667?ttl=0&recv_buf_size=8388608'
 LAN='udpm://239.255.76.68:7668?ttl=1'
 SIM_S=8
 
-lcm-logger -q -f -l "$LAN&recv_buf_size=8388608" "$WORK/lan.lcmlog" &
+lcm-logger -q -f --lcm-url="$LAN&recv_buf_size=8388608" "$WORK/lan.lcmlog" &
 LAN_LOGGER=$!
 ADIT_LCM_URL="$LOCAL" "$BIN/adit" launch "$ROOT/launch/live.launch.yaml" --set RECORD='.*' --set LAN_URL="$LAN" \
   --log-dir "$WORK" --quiet --duration $((SIM_S + 8)) &

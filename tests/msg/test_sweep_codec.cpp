@@ -59,13 +59,15 @@ TEST_P(SensorSweeps, GridLayoutDecodesWithinTheSensorResolution) {
     const adit::lidar_scan_t m = msg::encodeSweep(scan, &s.table);
     ASSERT_EQ(m.layout, +adit::lidar_scan_t::LAYOUT_GRID) << GetParam();
     const Fidelity f = roundTrip(scan, m);
+    // Half a range count (1 mm) at any range: the azimuth of a column is kept to 2 pi / 2^32.
+    EXPECT_LE(f.worst_m, 0.5 * m.range_scale + 1e-4);
     // Firing times survive to float rounding of the original (a few ns): deskewing sees no difference.
     EXPECT_LT(f.worst_dt_s, 2e-8);
     const std::size_t full = static_cast<std::size_t>(msg::toMessage(scan).getEncodedSize());
     std::printf("%s: %zu points, %zu columns, %zu bytes compact vs %zu full (%.1fx), worst error %.2f mm\n",
                 GetParam(), scan.points.size(), static_cast<std::size_t>(m.num_columns), f.bytes, full,
                 static_cast<double>(full) / static_cast<double>(f.bytes), f.worst_m * 1e3);
-    // 3 bytes a firing + 6 a column: at most a sixth of the full-float form at the simulator's few dropouts.
+    // 3 bytes a firing + 8 a column: at most a sixth of the full-float form at the simulator's few dropouts.
     EXPECT_LT(f.bytes * 5, full);
     // Encoding is a pure function of the sweep.
     EXPECT_EQ(msg::encode(m), msg::encode(msg::encodeSweep(scan, &s.table)));
