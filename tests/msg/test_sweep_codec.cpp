@@ -5,6 +5,7 @@
 #include "msg/convert.hpp"
 #include "msg/encode.hpp"
 #include "msg/sweep_codec.hpp"
+#include "nodes/registry.hpp"
 #include "sim_sweeps.hpp"
 
 #include <gtest/gtest.h>
@@ -189,6 +190,41 @@ TEST(SweepCodec, EmptyAndNonFiniteSweepsEncode) {
   EXPECT_EQ(msg::decodeSweep(with_nan, out), "");
   EXPECT_EQ(out.points.size(), n - 1);  // the NaN point is left out, the rest keeps the grid
   EXPECT_EQ(with_nan.layout, +adit::lidar_scan_t::LAYOUT_GRID);
+}
+
+}  // namespace
+}  // namespace adit
+
+namespace adit {
+namespace {
+
+class CollectingSink : public runtime::Sink {
+ public:
+  void publish(const std::string& channel, const runtime::Bytes&, std::int64_t) override { channels.push_back(channel); }
+  std::vector<std::string> channels;
+};
+
+TEST(FeatureNode, ReadsBothSweepFormatsAndCountsCompactSweepsThatDoNotFit) {
+  const test::SimSweeps s = test::simulateSweeps("vlp16", 4);
+  auto node = nodes::makeNode("feature", Config{});
+  CollectingSink sink;
+  const auto deliver = [&](const std::vector<std::uint8_t>& bytes) {
+    node->deliver("LIDAR_POINTS", bytes.data(), bytes.size(), sink);
+  };
+  deliver(msg::encode(msg::toMessage(s.sweeps[0])));             // today's full-float format
+  deliver(msg::encode(msg::encodeSweep(s.sweeps[1], &s.table)));  // compact
+  adit::lidar_scan_t future = msg::encodeSweep(s.sweeps[2], &s.table);
+  future.format_version = 2;
+  deliver(msg::encode(future));
+  adit::lidar_scan_t misfit = msg::encodeSweep(s.sweeps[3], &s.table);
+  misfit.column_time_ns[0] = -800'000'000;  // a column far before the sweep
+  deliver(msg::encode(misfit));
+  EXPECT_EQ(sink.channels, (std::vector<std::string>{"FEATURES", "FEATURES"}));
+  const runtime::Health& h = node->health();
+  EXPECT_EQ(h.counters.at("unknown_format_version"), 1);
+  EXPECT_EQ(h.counters.at("invalid_sweep"), 1);
+  EXPECT_EQ(h.errors, 2);
+  EXPECT_NE(h.last_error.find("outside the sweep"), std::string::npos) << h.last_error;
 }
 
 }  // namespace
