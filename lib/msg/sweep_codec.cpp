@@ -15,6 +15,7 @@ constexpr double kColumnAzimuthUnit = kTwoPi / 4294967296.0;  // rad per column_
 constexpr double kElevationUnit = M_PI / 2.0 / 32767.0;  // rad per elevation count
 // Columns further apart in time than this belong to different firing sequences (a slot is >= 0.75 us).
 constexpr double kColumnTimeTolerance_ns = 300.0;
+constexpr int kElevationSamples = 64;
 
 std::int16_t toU16(long v) { return static_cast<std::int16_t>(static_cast<std::uint16_t>(std::clamp(v, 0L, 65535L))); }
 double fromU16(std::int16_t v) { return static_cast<double>(static_cast<std::uint16_t>(v)); }
@@ -120,10 +121,9 @@ struct GridColumn {
 };
 
 // The average spin rate (rad/s): the wrapped azimuth steps between consecutive points over the time they span.
-double spinRate(const std::vector<LidarPoint>& points) {
+double spinRate(const std::vector<LidarPoint>& points, const std::vector<double>& azimuth) {
   double turned = 0.0;
-  for (std::size_t i = 1; i < points.size(); ++i)
-    turned += wrapPi(std::atan2(points[i].p.y(), points[i].p.x()) - std::atan2(points[i - 1].p.y(), points[i - 1].p.x()));
+  for (std::size_t i = 1; i < points.size(); ++i) turned += wrapPi(azimuth[i] - azimuth[i - 1]);
   const double span = static_cast<double>(points.back().dt) - static_cast<double>(points.front().dt);
   return span > 0 ? turned / span : 0.0;
 }
@@ -133,7 +133,9 @@ bool encodeGrid(const LidarScan& scan, const std::vector<LidarPoint>& points, co
   const int beams = table.beams();
   if (points.size() < 2 || beams != scan.num_beams || beams <= 0 || beams > 255 || !scan.has_ring || !scan.has_time)
     return false;
-  const double rate = spinRate(points);
+  std::vector<double> azimuth(points.size());
+  for (std::size_t i = 0; i < points.size(); ++i) azimuth[i] = std::atan2(points[i].p.y(), points[i].p.x());
+  const double rate = spinRate(points, azimuth);
   std::vector<double> elevation_sum(static_cast<std::size_t>(beams), 0.0);
   std::vector<int> elevation_n(static_cast<std::size_t>(beams), 0);
   std::vector<GridColumn> columns;
@@ -142,7 +144,7 @@ bool encodeGrid(const LidarScan& scan, const std::vector<LidarPoint>& points, co
     if (p.ring >= beams) return false;
     const double offset = table.ring_offset_ns[p.ring];
     const double t = static_cast<double>(p.dt) * 1e9 - offset;
-    const double az = std::atan2(p.p.y(), p.p.x()) - rate * offset * 1e-9;
+    const double az = azimuth[i] - rate * offset * 1e-9;
     GridColumn* c = columns.empty() ? nullptr : &columns.back();
     if (!c || std::fabs(t - c->time_ns) > kColumnTimeTolerance_ns || c->point_of_ring[p.ring] != SIZE_MAX) {
       GridColumn next;
@@ -153,8 +155,11 @@ bool encodeGrid(const LidarScan& scan, const std::vector<LidarPoint>& points, co
       c = &columns.back();
     }
     c->point_of_ring[p.ring] = i;
-    elevation_sum[p.ring] += std::atan2(p.p.z(), std::hypot(p.p.x(), p.p.y()));
-    elevation_n[p.ring] += 1;
+    // A ring's elevation is one constant: a few dozen samples average the float rounding out.
+    if (elevation_n[p.ring] < kElevationSamples) {
+      elevation_sum[p.ring] += std::atan2(p.p.z(), std::hypot(p.p.x(), p.p.y()));
+      elevation_n[p.ring] += 1;
+    }
   }
   // Points that fall in columns of their own (a table that is not this head's) make a grid larger than the
   // per-point layout (9 bytes a point): then it is no grid.
@@ -254,23 +259,29 @@ std::string decodeGrid(const adit::lidar_scan_t& m, LidarScan& s) {
   std::vector<int> order(static_cast<std::size_t>(beams));
   std::iota(order.begin(), order.end(), 0);
   std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return m.ring_offset_ns[a] < m.ring_offset_ns[b]; });
-  std::vector<double> cos_el(beams), sin_el(beams);
+  // Per ring: elevation and the azimuth the head turns between its column's time and its firing; per column
+  // one cos/sin, each firing by angle addition (no trigonometry per point).
+  std::vector<double> cos_el(beams), sin_el(beams), cos_turn(beams), sin_turn(beams);
   for (int r = 0; r < beams; ++r) {
     cos_el[r] = std::cos(static_cast<double>(m.ring_elevation[r]));
     sin_el[r] = std::sin(static_cast<double>(m.ring_elevation[r]));
+    const double turn = m.azimuth_rate * (m.ring_offset_ns[r] * 1e-9);
+    cos_turn[r] = std::cos(turn);
+    sin_turn[r] = std::sin(turn);
   }
   s.points.reserve(static_cast<std::size_t>(m.num_returns));
   for (int c = 0; c < m.num_columns; ++c) {
     const double az0 = static_cast<double>(static_cast<std::uint32_t>(m.column_azimuth[c])) * kColumnAzimuthUnit;
+    const double ca = std::cos(az0), sa = std::sin(az0);
     for (const int r : order) {
       const std::size_t k = static_cast<std::size_t>(c) * beams + static_cast<std::size_t>(r);
       if (m.range[k] == 0) continue;
       const double range = fromU16(m.range[k]) * m.range_scale;
       const double offset_s = m.ring_offset_ns[r] * 1e-9;
-      const double az = az0 + m.azimuth_rate * offset_s;
+      const double cos_az = ca * cos_turn[r] - sa * sin_turn[r], sin_az = sa * cos_turn[r] + ca * sin_turn[r];
       const double h = range * cos_el[r];
       LidarPoint p;
-      p.p = Eigen::Vector3f(static_cast<float>(h * std::cos(az)), static_cast<float>(h * std::sin(az)),
+      p.p = Eigen::Vector3f(static_cast<float>(h * cos_az), static_cast<float>(h * sin_az),
                             static_cast<float>(range * sin_el[r]));
       p.intensity = static_cast<float>(m.intensity[k]) * m.intensity_scale;
       p.ring = static_cast<std::uint16_t>(r);
