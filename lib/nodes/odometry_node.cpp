@@ -20,7 +20,8 @@ class OdometryNode : public runtime::Node {
         guess_config_(initialGuessConfigFrom(config)),
         imu_(config.get<double>("odometry.node.imu_keep_s", 1.0)) {
     // The sweep forwarded on ODOM_SCAN feeds only the mapper's global map (itself at 0.1 m). FEATURES already
-    // carries it thinned (features.node.map_cloud_voxel); this thins it again only if set coarser. 0 = as is.
+    // carries it thinned to features.node.map_cloud_voxel (0.1 m): thinning at the same voxel again changes
+    // next to nothing (voxel centroids), a coarser one thins it further. 0 = forward it as received.
     forward_voxel_ = config.get<double>("odometry.node.forward_cloud_voxel", 0.1);
     subscribe<adit::features_t>("features", "FEATURES", [this](const adit::features_t& m) { onFeatures(m); });
     subscribe<adit::imu_t>("imu", "IMU", [this](const adit::imu_t& m) { imu_.add(m); });
