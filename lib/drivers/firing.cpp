@@ -46,6 +46,14 @@ Eigen::Vector3f BeamTable::point(double range_m, double azimuth_deg, int laser) 
           static_cast<float>(range_m * sin_elevation[laser])};
 }
 
+msg::FiringTable firingTable(const BeamTable& beams, std::int64_t firing_ns) {
+  msg::FiringTable t;
+  t.ring_offset_ns.assign(kBeams, 0);
+  for (int laser = 0; laser < kBeams; ++laser)
+    t.ring_offset_ns[beams.ring[laser]] = static_cast<std::int32_t>(laser * firing_ns);
+  return t;
+}
+
 void resetPacket(DecodedPacket& packet, SensorClock clock) {
   std::vector<Firing> firings = std::move(packet.firings);
   firings.clear();

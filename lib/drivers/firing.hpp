@@ -7,6 +7,8 @@
 // x = r cos(elev) cos(az), y = -r cos(elev) sin(az), z = r sin(elev).
 #pragma once
 
+#include "msg/firing_table.hpp"
+
 #include <Eigen/Core>
 
 #include <array>
@@ -66,6 +68,10 @@ struct BeamTable {
   // Lidar-frame point of a return at `range_m` from laser `laser` at sensor azimuth `azimuth_deg`.
   Eigen::Vector3f point(double range_m, double azimuth_deg, int laser) const;
 };
+
+// The head's firing table for the compact sweep encoder: ring of laser slot k fires k * firing_ns after its
+// sequence's first firing (VLP-16: 2304 ns, RS-16: 2800 ns).
+msg::FiringTable firingTable(const BeamTable& beams, std::int64_t firing_ns);
 
 // Empties `packet` for the next decode, keeping its firing buffer (no allocation per packet).
 void resetPacket(DecodedPacket& packet, SensorClock clock);

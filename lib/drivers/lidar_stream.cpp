@@ -33,6 +33,8 @@ bool worthLogging(std::int64_t n) {
 LidarPacketStream::LidarPacketStream(const LidarStreamConfig& config)
     : sensor_time_(config.clock.source == TimeSource::kSensor), clock_(config.clock), assembler_(config.sweep) {
   const std::array<double, kBeams> elevations = elevationTable(config);
+  firing_table_ = drivers::firingTable(BeamTable::fromElevationsDeg(elevations),
+                                       config.model == LidarModel::kVlp16 ? kVlp16FiringNs : kRs16FiringNs);
   if (config.model == LidarModel::kVlp16) {
     auto decoder = std::make_shared<Vlp16Decoder>(elevations);
     decode_ = [decoder](const std::uint8_t* d, std::size_t n, DecodedPacket& out) { return decoder->decode(d, n, out); };

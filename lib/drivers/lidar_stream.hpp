@@ -45,6 +45,8 @@ class LidarPacketStream {
 
   // inputs = packets, outputs = sweeps published.
   const runtime::Health& health() const { return health_; }
+  // The head's firing table (for msg::encodeSweep).
+  const msg::FiringTable& firingTable() const { return firing_table_; }
 
  private:
   void count(const std::string& counter, std::int64_t& total, const std::string& what);
@@ -55,6 +57,7 @@ class LidarPacketStream {
   PacketClock clock_;
   SweepAssembler assembler_;
   DecodedPacket packet_;  // reused between packets
+  msg::FiringTable firing_table_;
   runtime::Health health_;
 };
 

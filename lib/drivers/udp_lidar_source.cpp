@@ -5,6 +5,7 @@
 #include "drivers/vlp16_decoder.hpp"
 #include "msg/convert.hpp"
 #include "msg/encode.hpp"
+#include "msg/sweep_codec.hpp"
 #include "runtime/process.hpp"
 
 #include <spdlog/spdlog.h>
@@ -62,7 +63,7 @@ class UdpLidarSource : public runtime::MessageSource {
       }
     }
     LidarScan& scan = ready_.front();
-    adit::point_cloud_t m = msg::toMessage(scan);
+    adit::lidar_scan_t m = msg::encodeSweep(scan, &stream_.firingTable());
     out.channel = channel_;
     out.data = msg::encode(m);
     out.utime = scan.utime;

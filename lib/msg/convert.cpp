@@ -3,6 +3,7 @@
 #include "core/geometry.hpp"
 
 #include <algorithm>
+#include <cmath>
 
 namespace adit::msg {
 namespace {
@@ -119,23 +120,51 @@ ImuSample fromMessage(const adit::imu_t& m) {
   return imu;
 }
 
+namespace {
+
+std::int32_t sweepFlags(const LidarScan& scan) {
+  return (scan.has_ring ? adit::point_cloud_t::FLAG_HAS_RING : 0) |
+         (scan.has_time ? adit::point_cloud_t::FLAG_HAS_TIME : 0) |
+         (scan.deskewed ? adit::point_cloud_t::FLAG_DESKEWED : 0);
+}
+
+void setSweepFlags(std::int32_t flags, LidarScan& scan) {
+  scan.has_ring = (flags & adit::point_cloud_t::FLAG_HAS_RING) != 0;
+  scan.has_time = (flags & adit::point_cloud_t::FLAG_HAS_TIME) != 0;
+  scan.deskewed = (flags & adit::point_cloud_t::FLAG_DESKEWED) != 0;
+}
+
+}  // namespace
+
 adit::features_t toMessage(const FeatureSet& f) {
   adit::features_t m;
   m.header = makeHeader(f.utime, "lidar");
   m.header.seq = f.cloud.seq;
-  m.cloud = toMessage(f.cloud);
-  m.corner_sharp = toMessage(f.corner_sharp, f.cloud);
-  m.corner_less_sharp = toMessage(f.corner_less_sharp, f.cloud);
-  m.surf_flat = toMessage(f.surf_flat, f.cloud);
-  m.surf_less_flat = toMessage(f.surf_less_flat, f.cloud);
+  m.sensor = f.cloud.sensor;
+  m.num_beams = static_cast<std::int16_t>(f.cloud.num_beams);
+  m.sweep_duration = f.cloud.sweep_duration;
+  m.sweep_flags = sweepFlags(f.cloud);
+  // Times only for a raw sweep: registration compensates it with them; a deskewed one needs none.
+  const PointSetFields loam{true, !f.cloud.deskewed};
+  m.corner_sharp = toPointSet(f.corner_sharp, loam);
+  m.corner_less_sharp = toPointSet(f.corner_less_sharp, loam);
+  m.surf_flat = toPointSet(f.surf_flat, loam);
+  m.surf_less_flat = toPointSet(f.surf_less_flat, loam);
+  m.map_cloud = toPointSet(f.cloud.points, {false, !f.cloud.deskewed});
   const std::size_t n = std::min(f.keypoints.size(), f.descriptors.size());
   m.num_keypoints = static_cast<std::int32_t>(n);
   m.descriptor_size = static_cast<std::int16_t>(kLinK3dBins);
+  m.descriptor_scale = kDescriptorScale;
   m.keypoints.assign(n, std::vector<float>(3));
-  m.descriptors.assign(n, std::vector<float>(kLinK3dBins));
+  m.descriptors.assign(n, std::vector<std::int16_t>(kLinK3dBins));
   for (std::size_t i = 0; i < n; ++i) {
     for (int k = 0; k < 3; ++k) m.keypoints[i][k] = f.keypoints[i][k];
-    std::copy(f.descriptors[i].begin(), f.descriptors[i].end(), m.descriptors[i].begin());
+    for (int b = 0; b < kLinK3dBins; ++b) {
+      const float d = f.descriptors[i][static_cast<std::size_t>(b)];
+      // A non-empty bin never rounds to the empty value 0.
+      const long c = d > 0.0f ? std::max(1L, std::lround(d / kDescriptorScale)) : 0L;
+      m.descriptors[i][static_cast<std::size_t>(b)] = static_cast<std::int16_t>(std::min(c, 32767L));
+    }
   }
   m.flags = f.flags;
   m.points_in = f.points_in;
@@ -148,17 +177,24 @@ adit::features_t toMessage(const FeatureSet& f) {
 FeatureSet fromMessage(const adit::features_t& m) {
   FeatureSet f;
   f.utime = m.header.utime;
-  f.cloud = fromMessage(m.cloud);
-  f.corner_sharp = pointsFromMessage(m.corner_sharp);
-  f.corner_less_sharp = pointsFromMessage(m.corner_less_sharp);
-  f.surf_flat = pointsFromMessage(m.surf_flat);
-  f.surf_less_flat = pointsFromMessage(m.surf_less_flat);
+  f.cloud.utime = m.header.utime;
+  f.cloud.seq = m.header.seq;
+  f.cloud.sensor = m.sensor;
+  f.cloud.num_beams = m.num_beams;
+  f.cloud.sweep_duration = m.sweep_duration;
+  setSweepFlags(m.sweep_flags, f.cloud);
+  f.cloud.points = fromPointSet(m.map_cloud);
+  f.corner_sharp = fromPointSet(m.corner_sharp);
+  f.corner_less_sharp = fromPointSet(m.corner_less_sharp);
+  f.surf_flat = fromPointSet(m.surf_flat);
+  f.surf_less_flat = fromPointSet(m.surf_less_flat);
   // A descriptor of another size cannot be compared with ours: keep the keypoints only if sizes agree.
-  if (m.descriptor_size == kLinK3dBins) {
+  if (m.descriptor_size == kLinK3dBins && m.descriptor_scale > 0.0f && std::isfinite(m.descriptor_scale)) {
     for (int i = 0; i < m.num_keypoints; ++i) {
       f.keypoints.emplace_back(m.keypoints[i][0], m.keypoints[i][1], m.keypoints[i][2]);
       LinK3dDescriptor d{};
-      std::copy(m.descriptors[i].begin(), m.descriptors[i].end(), d.begin());
+      for (int b = 0; b < kLinK3dBins; ++b)
+        d[static_cast<std::size_t>(b)] = static_cast<float>(m.descriptors[i][static_cast<std::size_t>(b)]) * m.descriptor_scale;
       f.descriptors.push_back(d);
     }
   }
@@ -185,9 +221,30 @@ adit::odometry_t toMessage(const PoseEstimate& pose, const FeatureSet* features)
   std::copy(identity_rotation, identity_rotation + 4, m.loop_correction_orientation);
   m.iterations = pose.iterations;
   m.final_cost = pose.final_cost;
-  m.features = features ? toMessage(*features) : toMessage(FeatureSet{});
+  m.sweep_flags = 0;
+  m.corners = m.surfaces = m.cloud = emptyPointSet();
+  if (features) {
+    m.sweep_flags = sweepFlags(features->cloud);
+    const bool times = !features->cloud.deskewed;
+    m.corners = toPointSet(features->corner_less_sharp, {false, times});
+    m.surfaces = toPointSet(features->surf_less_flat, {false, times});
+    m.cloud = toPointSet(features->cloud.points, {false, times});
+  }
   return m;
 }
+
+FeatureSet featuresOf(const adit::odometry_t& m) {
+  FeatureSet f;
+  f.utime = m.header.utime;
+  f.cloud.utime = m.header.utime;
+  setSweepFlags(m.sweep_flags, f.cloud);
+  f.corner_less_sharp = fromPointSet(m.corners);
+  f.surf_less_flat = fromPointSet(m.surfaces);
+  f.cloud.points = fromPointSet(m.cloud);
+  return f;
+}
+
+void stripPoints(adit::odometry_t& m) { m.corners = m.surfaces = m.cloud = emptyPointSet(); }
 
 PoseEstimate fromMessage(const adit::odometry_t& m) {
   PoseEstimate p;

@@ -3,6 +3,7 @@
 #pragma once
 
 #include "core/types.hpp"
+#include "msg/point_set.hpp"
 
 #include <adit/features_t.hpp>
 #include <adit/imu_t.hpp>
@@ -23,12 +24,23 @@ std::vector<LidarPoint> pointsFromMessage(const adit::point_cloud_t& msg);
 adit::imu_t toMessage(const ImuSample& imu);
 ImuSample fromMessage(const adit::imu_t& msg);
 
+// LinK3D descriptor bins on FEATURES: int16 counts of 2 mm (to 65 m), a hundredth of the 0.2 m bin tolerance.
+constexpr float kDescriptorScale = 0.002f;
+
+// FEATURES: the four LOAM sets (rings; times only if not deskewed), FeatureSet::cloud as map_cloud (the
+// caller thins it first), keypoints and descriptors. fromMessage gives cloud.points without rings.
 adit::features_t toMessage(const FeatureSet& features);
 FeatureSet fromMessage(const adit::features_t& msg);
 
-// features may be empty (nullptr) when the receiver does not need them.
+// ODOM_SCAN / ODOM_MAPPED: features may be nullptr (GROUND_TRUTH): no points. Otherwise the message carries
+// features->corner_less_sharp, surf_less_flat and cloud.points (whatever of them the caller left non-empty).
 adit::odometry_t toMessage(const PoseEstimate& pose, const FeatureSet* features);
 PoseEstimate fromMessage(const adit::odometry_t& msg);
+// The points an odometry_t carries, as the FeatureSet fields they came from (corner_less_sharp,
+// surf_less_flat, cloud with its deskewed flag).
+FeatureSet featuresOf(const adit::odometry_t& msg);
+// The pose alone: for monitoring copies (LAN relay, replay output).
+void stripPoints(adit::odometry_t& msg);
 
 adit::loop_closure_t toMessage(const LoopConstraint& loop, std::int64_t utime);
 LoopConstraint fromMessage(const adit::loop_closure_t& msg);

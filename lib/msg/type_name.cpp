@@ -2,6 +2,7 @@
 
 #include <adit/features_t.hpp>
 #include <adit/imu_t.hpp>
+#include <adit/lidar_scan_t.hpp>
 #include <adit/loop_closure_t.hpp>
 #include <adit/map_update_t.hpp>
 #include <adit/odometry_t.hpp>
@@ -23,6 +24,7 @@ std::string messageTypeName(const std::uint8_t* data, std::size_t size) {
   if (size < 8) return "";
   std::int64_t hash = 0;
   for (int i = 0; i < 8; ++i) hash = static_cast<std::int64_t>((static_cast<std::uint64_t>(hash) << 8) | data[i]);
+  if (hasHash<adit::lidar_scan_t>(hash)) return "lidar_scan_t";
   if (hasHash<adit::point_cloud_t>(hash)) return "point_cloud_t";
   if (hasHash<adit::imu_t>(hash)) return "imu_t";
   if (hasHash<adit::features_t>(hash)) return "features_t";

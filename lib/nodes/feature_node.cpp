@@ -1,7 +1,9 @@
 #include "nodes/feature_node.hpp"
 
 #include "features/feature_extractor.hpp"
+#include "features/preprocess.hpp"
 #include "msg/convert.hpp"
+#include "msg/sweep_codec.hpp"
 #include "nodes/imu_buffer.hpp"
 
 #include <deque>
@@ -25,7 +27,11 @@ class FeatureNode : public runtime::Node {
         imu_(config.get<double>("features.node.imu_keep_s", 0.5)) {
     // An odometry pose older than this (s) before a sweep is too stale to predict its motion.
     max_prior_age_s_ = config.get<double>("features.node.max_prior_age_s", 0.3);
-    subscribe<adit::point_cloud_t>("points", "LIDAR_POINTS", [this](const adit::point_cloud_t& m) { onSweep(m); });
+    // FEATURES carries the sweep only thinned to this voxel (m): what the mapper's global map (0.1 m) and,
+    // thinned again, the loop closer's keyframes need. 0 = the whole preprocessed sweep (5x the bytes).
+    map_cloud_voxel_ = config.get<double>("features.node.map_cloud_voxel", 0.1);
+    // LIDAR_POINTS in either form: compact lidar_scan_t or the full-float point_cloud_t of older logs.
+    subscribe<msg::SweepMessage>("points", "LIDAR_POINTS", [this](const msg::SweepMessage& m) { onSweep(m); });
     subscribe<adit::imu_t>("imu", "IMU", [this](const adit::imu_t& m) { imu_.add(m); });
     subscribe<adit::odometry_t>("odometry", "ODOM_SCAN", [this](const adit::odometry_t& m) { onOdometry(m); });
     advertise("features", "FEATURES");
@@ -55,9 +61,14 @@ class FeatureNode : public runtime::Node {
     if (held_ && !sweeps_.empty() && m.header.utime == sweeps_.back()) processHeld();
   }
 
-  void onSweep(const adit::point_cloud_t& m) {
+  void onSweep(const msg::SweepMessage& m) {
+    if (!m.error.empty()) {
+      reportError(m.unknown_version ? "unknown_format_version" : "invalid_sweep",
+                  "LIDAR_POINTS sweep at utime " + std::to_string(m.header.utime) + ": " + m.error + ": skipped");
+      return;
+    }
     processHeld();  // its prior never came: go on without it
-    LidarScan scan = msg::fromMessage(m);
+    LidarScan scan = m.scan;
     const bool prior_pending = odometry_seen_ && !sweeps_.empty() && !poses_.count(sweeps_.back());
     if (prior_pending) {
       held_ = std::move(scan);
@@ -94,7 +105,7 @@ class FeatureNode : public runtime::Node {
     std::vector<ImuSample> imu = imu_.samples();
     // Only what was measured up to the sweep's end: later samples may or may not have arrived yet.
     while (!imu.empty() && imu.back().utime > scan.utime) imu.pop_back();
-    const FeatureSet features = extractor_.process(scan, imu, motionPrior(scan.utime));
+    FeatureSet features = extractor_.process(scan, imu, motionPrior(scan.utime));
     sweeps_.push_back(scan.utime);
     if (sweeps_.size() > 2) sweeps_.pop_front();
     count("points_in", features.points_in);
@@ -103,6 +114,8 @@ class FeatureNode : public runtime::Node {
     count("removed_outlier", features.removed_outlier);
     if (features.flags & FeatureSet::kFewKeypoints) count("few_keypoints");
     if (features.flags & FeatureSet::kEmptyRing) count("empty_ring");
+    if (map_cloud_voxel_ > 0)
+      features.cloud.points = features::voxelDownsample(features.cloud.points, static_cast<float>(map_cloud_voxel_));
     adit::features_t out = msg::toMessage(features);
     publish("features", out);
   }
@@ -110,6 +123,7 @@ class FeatureNode : public runtime::Node {
   FeatureExtractor extractor_;
   ImuBuffer imu_;
   double max_prior_age_s_ = 0.3;
+  double map_cloud_voxel_ = 0.1;
   std::deque<std::int64_t> sweeps_;                 // utimes of the last two sweeps processed
   std::map<std::int64_t, Eigen::Isometry3d> poses_;  // recent ODOM_SCAN poses by sweep utime
   std::optional<LidarScan> held_;                    // a sweep waiting for the previous sweep's pose

@@ -85,7 +85,7 @@ class LoopCloserNode : public runtime::Node, public WritesProducts {
     PoseEstimate mapped = msg::fromMessage(m);
     // The graph is built on uncorrected poses: undo the correction the mapper had already applied.
     mapped.pose = makePose(m.loop_correction_position, m.loop_correction_orientation).inverse() * mapped.pose;
-    const LidarScan cloud = msg::fromMessage(m.features.cloud);
+    const LidarScan cloud = msg::featuresOf(m).cloud;
     uncorrected_.push_back({mapped.utime, mapped.pose});
     const LoopCloser::Result result = closer_.process(mapped, cloud);
     for (const LoopConstraint& loop : result.loops) {

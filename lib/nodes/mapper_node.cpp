@@ -76,9 +76,9 @@ class MapperNode : public runtime::Node, public WritesProducts {
 
  private:
   void onOdometry(const adit::odometry_t& m) {
-    FeatureSet features = msg::fromMessage(m.features);
+    FeatureSet features = msg::featuresOf(m);
     const PoseEstimate mapped = mapper_.process(features, msg::fromMessage(m));
-    // The loop closer needs the pose, the sweep and the keypoints, not the LOAM sets.
+    // The loop closer needs the pose and the thinned sweep, not the LOAM sets.
     features.corner_less_sharp.clear();
     features.surf_less_flat.clear();
     if (forward_voxel_ > 0)

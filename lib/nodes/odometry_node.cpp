@@ -25,8 +25,9 @@ class OdometryNode : public runtime::Node {
         guess_config_(initialGuessConfigFrom(config)),
         imu_(config.get<double>("odometry.node.imu_keep_s", 1.0)),
         state_("odometry") {
-    // The sweep forwarded on ODOM_SCAN feeds only the mapper's global map (itself at 0.1 m): thin it to
-    // that resolution so the bus and the logs carry a third of the bytes. 0 = forward it whole.
+    // The sweep forwarded on ODOM_SCAN feeds only the mapper's global map (itself at 0.1 m). FEATURES already
+    // carries it thinned to features.node.map_cloud_voxel (0.1 m): thinning at the same voxel again changes
+    // next to nothing (voxel centroids), a coarser one thins it further. 0 = forward it as received.
     forward_voxel_ = config.get<double>("odometry.node.forward_cloud_voxel", 0.1);
     // Sensor seconds between checkpoints of the pose (live runs only; a few hundred bytes each).
     checkpoint_period_us_ = toUtime(config.get<double>("odometry.node.checkpoint_period_s", 0.5));
@@ -91,7 +92,7 @@ class OdometryNode : public runtime::Node {
     if (pose.flags & PoseEstimate::kRegistrationFailed) count("registration_failed");
     if (pose.flags & PoseEstimate::kDegenerateTranslation) count("degenerate_translation");
     previous_ = features;
-    // Downstream needs neither the odometry-only sets nor the full-density sweep.
+    // The mapper needs the less-sharp / less-flat sets and the thinned sweep (odometry_t carries only those).
     features.corner_sharp.clear();
     features.surf_flat.clear();
     if (forward_voxel_ > 0)

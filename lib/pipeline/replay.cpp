@@ -1,6 +1,8 @@
 #include "pipeline/replay.hpp"
 
 #include "io/atomic_file.hpp"
+#include "msg/convert.hpp"
+#include "msg/encode.hpp"
 #include "msg/type_name.hpp"
 #include "nodes/products.hpp"
 #include "nodes/registry.hpp"
@@ -111,14 +113,21 @@ ReplayReport runReplay(const ReplayOptions& options) {
   Input input(options);
   runtime::LogWriter output((fs::path(options.out_dir) / "output.lcmlog").string());
   runtime::LockstepBus bus;
-  const std::regex record(options.record);
+  const std::regex record(options.record), record_poses(options.record_poses);
   // A failed write (disk full) happens inside a node's publish, where stage errors are counted and the run
   // goes on: keep it here and end the replay with it after the delivery (the writer has removed its file).
   std::string write_error;
   bus.observe([&](const std::string& channel, const runtime::Bytes& data, std::int64_t utime) {
-    if (!write_error.empty() || !std::regex_match(channel, record)) return;
+    if (!write_error.empty()) return;
     try {
-      output.write(channel, data, utime);
+      if (std::regex_match(channel, record)) {
+        output.write(channel, data, utime);
+      } else if (!options.record_poses.empty() && std::regex_match(channel, record_poses)) {
+        adit::odometry_t m;
+        if (m.decode(data.data(), 0, static_cast<int>(data.size())) < 0) return;
+        msg::stripPoints(m);
+        output.write(channel, msg::encode(m), utime);
+      }
     } catch (const std::exception& e) {
       write_error = e.what();
     }
@@ -132,7 +141,8 @@ ReplayReport runReplay(const ReplayOptions& options) {
   std::int64_t first_utime = -1, last_utime = -1;
   while (!runtime::stopRequested() && input.next(event)) {
     ++report.input_events;
-    if (msg::messageTypeName(event.data.data(), event.data.size()) == "point_cloud_t") ++report.sweeps;
+    const std::string type = msg::messageTypeName(event.data.data(), event.data.size());
+    if (type == "lidar_scan_t" || type == "point_cloud_t") ++report.sweeps;
     if (first_utime < 0) first_utime = event.timestamp;
     last_utime = std::max(last_utime, event.timestamp);
     bus.inject(event.channel, event.data, event.timestamp);

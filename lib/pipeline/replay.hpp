@@ -28,6 +28,9 @@ struct ReplayOptions {
   Config config;
   std::vector<std::string> stages;  // empty: every stage that is written
   std::string record = ".*";        // regex of the channels written to output.lcmlog
+  // Regex of odometry_t channels not matched by `record` written to output.lcmlog as the pose alone (points
+  // stripped): the trajectory in a few hundred bytes a sweep. "" = none.
+  std::string record_poses;
   // Called now and then with the fraction of the input consumed (progress bars).
   std::function<void(double)> on_progress;
 };

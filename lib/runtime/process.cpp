@@ -18,13 +18,15 @@ void onSignal(int) { g_stop = 1; }
 
 class LcmSink : public Sink {
  public:
-  explicit LcmSink(lcm::LCM& lcm) : lcm_(lcm) {}
+  LcmSink(lcm::LCM& lcm, PublishedTraffic& traffic) : lcm_(lcm), traffic_(traffic) {}
   void publish(const std::string& channel, const Bytes& data, std::int64_t) override {
     lcm_.publish(channel, data.data(), static_cast<unsigned int>(data.size()));
+    traffic_.add(channel, data.size());
   }
 
  private:
   lcm::LCM& lcm_;
+  PublishedTraffic& traffic_;
 };
 
 // Receives raw LCM buffers and hands them to the node.
@@ -122,7 +124,8 @@ int runNodeProcess(int argc, char** argv, const std::string& name, const std::st
     }
   }
   lcm::LCM& out = separate_out ? *separate_out : in;
-  LcmSink sink(out);
+  PublishedTraffic traffic;
+  LcmSink sink(out, traffic);
   Receiver receiver(*node, sink);
   for (const auto& channel : node->inputChannels()) in.subscribe(channel, &Receiver::onMessage, &receiver);
 
@@ -144,7 +147,10 @@ int runNodeProcess(int argc, char** argv, const std::string& name, const std::st
     if (reported == "behind") spdlog::warn("busy {:.0f}% of the time: falling behind its input", busy * 100);
     adit::status_t status = makeStatus(*node, wallUtime(), status_seq++,
                                        std::chrono::duration<double>(now - start).count(), rate, busy, reported);
-    out.publish(status_channel, &status);
+    traffic.report(status, window);
+    const Bytes bytes = msg::encode(status);
+    out.publish(status_channel, bytes.data(), static_cast<unsigned int>(bytes.size()));
+    traffic.add(status_channel, bytes.size());
     last_status = now;
     inputs_at_last_status = h.inputs;
     busy_at_last_status = h.busy_s;

@@ -49,6 +49,7 @@ int publishLive(MessageSource& source, const SourceRunOptions& options) {
   auto last_status = start;
   std::int64_t status_seq = 0, published = 0, published_at_last_status = 0;
   TimingWindow no_timing;
+  PublishedTraffic traffic;
   const auto sendStatus = [&](const std::string& state) {
     const auto now = Clock::now();
     const double window = std::chrono::duration<double>(now - last_status).count();
@@ -57,7 +58,10 @@ int publishLive(MessageSource& source, const SourceRunOptions& options) {
     const double rate = window > 0 ? static_cast<double>(published - published_at_last_status) / window : 0.0;
     adit::status_t s = makeStatus(options.process, h, no_timing, wallUtime(), status_seq++,
                                   std::chrono::duration<double>(now - start).count(), rate, 0.0, state);
-    lcm.publish(status_channel, &s);
+    traffic.report(s, window);
+    const Bytes bytes = msg::encode(s);
+    lcm.publish(status_channel, bytes.data(), static_cast<unsigned int>(bytes.size()));
+    traffic.add(status_channel, bytes.size());
     last_status = now;
     published_at_last_status = published;
   };
@@ -80,6 +84,7 @@ int publishLive(MessageSource& source, const SourceRunOptions& options) {
       }
     }
     lcm.publish(m.channel, m.data.data(), static_cast<unsigned int>(m.data.size()));
+    traffic.add(m.channel, m.data.size());
     ++published;
     if (Clock::now() - last_status >= std::chrono::duration<double>(options.status_period_s)) sendStatus("running");
   }

@@ -4,6 +4,26 @@
 
 namespace adit::runtime {
 
+void PublishedTraffic::add(const std::string& channel, std::size_t bytes) {
+  Count& c = window_[channel];
+  c.bytes += static_cast<std::int64_t>(bytes);
+  c.messages += 1;
+}
+
+void PublishedTraffic::report(adit::status_t& status, double window_s) {
+  status.num_channels = static_cast<std::int32_t>(window_.size());
+  status.channel_names.clear();
+  status.channel_bytes_per_s.clear();
+  status.channel_messages_per_s.clear();
+  for (auto& [channel, count] : window_) {
+    status.channel_names.push_back(channel);
+    status.channel_bytes_per_s.push_back(window_s > 0 ? static_cast<float>(static_cast<double>(count.bytes) / window_s) : 0.0f);
+    status.channel_messages_per_s.push_back(
+        window_s > 0 ? static_cast<float>(static_cast<double>(count.messages) / window_s) : 0.0f);
+    count = Count{};
+  }
+}
+
 std::string statusChannel(const std::string& process) {
   std::string out = "STATUS_";
   for (char c : process) out += c == '-' ? '_' : static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
@@ -36,6 +56,7 @@ adit::status_t makeStatus(const std::string& process, const Health& health, cons
     s.counter_values.push_back(kv.second);
   }
   s.last_error = health.last_error;
+  s.num_channels = 0;  // PublishedTraffic::report fills them
   return s;
 }
 

@@ -5,7 +5,26 @@
 
 #include <adit/status_t.hpp>
 
+#include <cstddef>
+#include <map>
+#include <string>
+
 namespace adit::runtime {
+
+// Bytes and messages a process publishes per channel between two STATUS reports: the bandwidth STATUS shows.
+class PublishedTraffic {
+ public:
+  void add(const std::string& channel, std::size_t bytes);
+  // Sets status's channel fields to the rates over window_s (every channel seen so far, silent ones at 0)
+  // and starts a new window.
+  void report(adit::status_t& status, double window_s);
+
+ private:
+  struct Count {
+    std::int64_t bytes = 0, messages = 0;
+  };
+  std::map<std::string, Count> window_;
+};
 
 // STATUS_<PROCESS> in capitals, '-' as '_': "loop-closer" -> "STATUS_LOOP_CLOSER".
 std::string statusChannel(const std::string& process);

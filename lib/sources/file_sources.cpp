@@ -4,6 +4,7 @@
 #include "io/kitti.hpp"
 #include "msg/convert.hpp"
 #include "msg/encode.hpp"
+#include "msg/sweep_codec.hpp"
 
 #include <spdlog/spdlog.h>
 
@@ -36,7 +37,8 @@ class ScanFileSource : public runtime::MessageSource {
       if (scan.points.empty()) health_.counters["empty_scan"] += 1;  // published: downstream flags it
       last_utime_ = scan.utime;
       scan.seq = seq_++;
-      adit::point_cloud_t m = msg::toMessage(scan);
+      // No firing table for recorded files: the compact per-point layout.
+      adit::lidar_scan_t m = msg::encodeSweep(scan, nullptr);
       out = {channel_, msg::encode(m), scan.utime};
       ++health_.outputs;
       return true;

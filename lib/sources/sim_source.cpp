@@ -1,12 +1,30 @@
 #include "sources/sim_source.hpp"
 
 #include "msg/convert.hpp"
+
+#include <cmath>
 #include "msg/encode.hpp"
 
 namespace adit::sources {
 
+msg::FiringTable firingTableOf(const sim::LidarProfile& profile) {
+  msg::FiringTable t;
+  const std::vector<std::uint16_t> rings = profile.rings();
+  t.ring_offset_ns.assign(rings.size(), 0);
+  for (std::size_t slot = 0; slot < rings.size(); ++slot)
+    t.ring_offset_ns[rings[slot]] = static_cast<std::int32_t>(std::lround(static_cast<double>(slot) * profile.firing_slot * 1e9));
+  return t;
+}
+
+}  // namespace adit::sources
+
+namespace adit::sources {
+
 SimSource::SimSource(const sim::SimConfig& config, SimChannels channels, SimStalls stalls)
-    : simulator_(config), channels_(std::move(channels)), stalls_(stalls) {}
+    : simulator_(config),
+      channels_(std::move(channels)),
+      stalls_(stalls),
+      firing_table_(firingTableOf(simulator_.lidar().profile())) {}
 
 double SimSource::progress() const {
   const auto total = simulator_.numSweeps();
@@ -32,8 +50,10 @@ bool SimSource::next(runtime::OutgoingMessage& out) {
     if (!scan) ++imu_seq_;
   }
   if (event.kind == sim::SimEvent::Kind::Scan) {
-    adit::point_cloud_t m = msg::toMessage(event.scan);
-    out = {channels_.lidar, msg::encode(m), event.scan.utime};
+    out = {channels_.lidar,
+           channels_.compact_sweeps ? msg::encode(msg::encodeSweep(event.scan, &firing_table_))
+                                    : msg::encode(msg::toMessage(event.scan)),
+           event.scan.utime};
     truth_.push_back(event.truth);
     if (!channels_.ground_truth.empty()) {
       PoseEstimate truth;

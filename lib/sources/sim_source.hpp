@@ -3,6 +3,7 @@
 #pragma once
 
 #include "core/types.hpp"
+#include "msg/sweep_codec.hpp"
 #include "runtime/source.hpp"
 #include "sim/simulator.hpp"
 
@@ -14,6 +15,8 @@ struct SimChannels {
   std::string lidar = "LIDAR_POINTS";
   std::string imu = "IMU";
   std::string ground_truth = "GROUND_TRUTH";  // "" = do not publish
+  // false: sweeps as full-float point_cloud_t, the format of logs before lidar_scan_t (tests of old logs).
+  bool compact_sweeps = true;
 };
 
 // Sensor outages for fault tests: a stream publishes nothing from start_s (seconds of sensor time after the
@@ -26,6 +29,10 @@ struct SimStalls {
   SimStall lidar, imu;
 };
 
+// The simulated head's firing table (ring of slot k fires k * firing_slot after its column), for encodeSweep.
+msg::FiringTable firingTableOf(const sim::LidarProfile& profile);
+
+// LIDAR_POINTS as compact lidar_scan_t (firing-grid layout), IMU, GROUND_TRUTH (odometry_t, pose only).
 class SimSource : public runtime::MessageSource {
  public:
   SimSource(const sim::SimConfig& config, SimChannels channels, SimStalls stalls = {});
@@ -43,6 +50,7 @@ class SimSource : public runtime::MessageSource {
   SimStalls stalls_;
   std::int64_t first_utime_ = -1;
   std::size_t sweeps_ = 0;  // simulated, stalled or not (progress)
+  msg::FiringTable firing_table_;
   runtime::Health health_;
   Trajectory truth_;
   std::optional<runtime::OutgoingMessage> pending_truth_;  // published right after its sweep

@@ -1,4 +1,6 @@
-// adit info <log>: what an LCM log holds, per channel: message count, type, time span and rate.
+// adit info <log>: what an LCM log holds, per channel: message count, type, time span, rate, size per message
+// and bandwidth (MB/s over the whole log's span, i.e. what the channel costs the bus and the disk), and the
+// whole log's rate.
 #include "commands.hpp"
 
 #include "msg/type_name.hpp"
@@ -7,6 +9,7 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <map>
 
 namespace {
@@ -37,12 +40,26 @@ void registerInfoCommand(CLI::App& app) {
     }
     if (channels.empty())
       throw std::runtime_error("'" + *path + "' holds no LCM event (empty, or not an LCM log)");
-    fmt::print("{:<24} {:>8} {:<16} {:>10} {:>9} {:>10}\n", "channel", "messages", "type", "span_s", "rate_hz", "MB");
+    // Bandwidth over the log's span (first to last event of any channel): a sparse channel's share of the run.
+    std::int64_t first = 0, last = 0, total = 0;
+    for (const auto& [name, s] : channels) {
+      first = total == 0 ? s.first : std::min(first, s.first);
+      last = std::max(last, s.last);
+      total += s.bytes;
+    }
+    const double log_span = static_cast<double>(last - first) * 1e-6;
+    const auto perSecond = [&](std::int64_t bytes) { return log_span > 0 ? static_cast<double>(bytes) / 1e6 / log_span : 0.0; };
+    fmt::print("{:<24} {:>8} {:<16} {:>10} {:>9} {:>10} {:>10} {:>9}\n", "channel", "messages", "type", "span_s",
+               "rate_hz", "MB", "kB/msg", "MB/s");
     for (const auto& [name, s] : channels) {
       const double span = static_cast<double>(s.last - s.first) * 1e-6;
-      fmt::print("{:<24} {:>8} {:<16} {:>10.3f} {:>9.2f} {:>10.2f}\n", name, s.count, s.type.empty() ? "?" : s.type,
-                 span, span > 0 ? static_cast<double>(s.count - 1) / span : 0.0, static_cast<double>(s.bytes) / 1e6);
+      fmt::print("{:<24} {:>8} {:<16} {:>10.3f} {:>9.2f} {:>10.2f} {:>10.2f} {:>9.3f}\n", name, s.count,
+                 s.type.empty() ? "?" : s.type, span, span > 0 ? static_cast<double>(s.count - 1) / span : 0.0,
+                 static_cast<double>(s.bytes) / 1e6, static_cast<double>(s.bytes) / 1e3 / static_cast<double>(s.count),
+                 perSecond(s.bytes));
     }
+    fmt::print("{:<24} {:>8} {:<16} {:>10.3f} {:>9} {:>10.2f} {:>10} {:>9.3f}\n", "total", "", "", log_span, "",
+               static_cast<double>(total) / 1e6, "", perSecond(total));
     if (reader.corruptFrames() || reader.truncated()) {
       spdlog::error("log '{}' is damaged: {} corrupt frame(s) skipped{}", *path, reader.corruptFrames(),
                     reader.truncated() ? ", truncated at the end" : "");

@@ -3,6 +3,8 @@
 #include "cli_helpers.hpp"
 
 #include <adit/features_t.hpp>
+#include <adit/lidar_scan_t.hpp>
+#include <adit/point_cloud_t.hpp>
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -30,9 +32,11 @@ fs::path Cli::dir_, Cli::log_;
 TEST_F(Cli, ImportWritesEverySweepWithRingsAndTimes) {
   const auto p = payloads(log_.string());
   ASSERT_EQ(p.at("LIDAR_POINTS").size(), 10u);
-  adit::point_cloud_t first;
+  // Compact sweeps: KITTI has no firing grid, so the per-point layout.
+  adit::lidar_scan_t first;
   const auto& bytes = p.at("LIDAR_POINTS").front();
   ASSERT_GT(first.decode(bytes.data(), 0, static_cast<int>(bytes.size())), 0);
+  EXPECT_EQ(first.layout, +adit::lidar_scan_t::LAYOUT_POINTS);
   EXPECT_EQ(first.num_beams, 64);
   EXPECT_GT(first.num_points, 100000);
   EXPECT_TRUE(first.flags & adit::point_cloud_t::FLAG_HAS_RING);
@@ -41,7 +45,9 @@ TEST_F(Cli, ImportWritesEverySweepWithRingsAndTimes) {
 
 TEST_F(Cli, ReplayTwiceGivesByteIdenticalOutputs) {
   for (const char* run_name : {"a", "b"})
-    ASSERT_EQ(run(bin("adit") + " replay " + log_.string() + " -o " + (dir_ / run_name).string(), dir_ / "replay.txt"), 0)
+    ASSERT_EQ(run(bin("adit") + " replay " + log_.string() + " --record-all -o " + (dir_ / run_name).string(),
+                  dir_ / "replay.txt"),
+              0)
         << slurp(dir_ / "replay.txt");
   const std::string a = slurp(dir_ / "a" / "output.lcmlog"), b = slurp(dir_ / "b" / "output.lcmlog");
   const auto p = payloads((dir_ / "a" / "output.lcmlog").string());
@@ -65,7 +71,8 @@ TEST_F(Cli, StageProcessDrivenFromALogMatchesReplay) {
                 dir_ / "feature.txt"),
             0)
       << slurp(dir_ / "feature.txt");
-  ASSERT_EQ(run(bin("adit") + " replay " + log_.string() + " --stages feature -o " + (dir_ / "feature_replay").string(),
+  ASSERT_EQ(run(bin("adit") + " replay " + log_.string() + " --stages feature --record-all -o " +
+                    (dir_ / "feature_replay").string(),
                 dir_ / "replay_feature.txt"),
             0);
   const auto process = payloads(out.string());
@@ -83,7 +90,8 @@ TEST_F(Cli, CorruptAndTruncatedLogsAreSkippedOverNotFatal) {
   std::ofstream(bad, std::ios::binary | std::ios::trunc) << bytes;
   const fs::path out = dir_ / "bad_replay";
   // Status 3: the outputs cover the readable part of a damaged log.
-  ASSERT_EQ(run(bin("adit") + " replay " + bad.string() + " -o " + out.string(), dir_ / "bad.txt"), 3) << slurp(dir_ / "bad.txt");
+  ASSERT_EQ(run(bin("adit") + " replay " + bad.string() + " --record-all -o " + out.string(), dir_ / "bad.txt"), 3)
+      << slurp(dir_ / "bad.txt");
   const std::string report = slurp(dir_ / "bad.txt");
   EXPECT_NE(report.find("truncated"), std::string::npos) << report;
   const auto p = payloads((out / "output.lcmlog").string());

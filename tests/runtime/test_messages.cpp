@@ -74,39 +74,85 @@ TEST(Messages, ImuRoundTripKeepsOptionalFields) {
   EXPECT_NEAR(out.orientation->angularDistance(*in.orientation), 0.0, 1e-12);
 }
 
-TEST(Messages, FeatureSetRoundTrip) {
-  adit::FeatureSet in;
-  in.utime = 5'000'000;
-  in.cloud = makeScan(50);
-  in.cloud.deskewed = true;
-  in.corner_sharp = makeScan(3).points;
-  in.corner_less_sharp = makeScan(6).points;
-  in.surf_flat = makeScan(4).points;
-  in.surf_less_flat = makeScan(9).points;
-  for (int k = 0; k < 7; ++k) {
-    in.keypoints.emplace_back(1.0f * k, 2.0f, -3.0f);
-    adit::LinK3dDescriptor d{};
-    d[static_cast<std::size_t>(k * 10)] = 1.5f + k;
-    in.descriptors.push_back(d);
+// FEATURES is lean (tests/msg has the quantisation figures): positions within half a count, rings on the LOAM
+// sets, times only for a raw sweep, no intensity, descriptors within half of 2 mm.
+namespace {
+void expectLeanPoints(const std::vector<adit::LidarPoint>& a, const std::vector<adit::LidarPoint>& b, bool rings,
+                      bool times) {
+  ASSERT_EQ(a.size(), b.size());
+  float largest = 0.0f;  // the set's scale: 1 mm, coarser if a coordinate exceeds 32.767 m
+  for (const auto& p : a) largest = std::max(largest, p.p.cwiseAbs().maxCoeff());
+  const float scale = std::max(adit::msg::kPointSetScale, largest / 32767.0f);
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    EXPECT_LE((a[i].p - b[i].p).cwiseAbs().maxCoeff(), 0.5f * scale + 1e-6f);
+    EXPECT_EQ(b[i].intensity, 0.0f);
+    EXPECT_EQ(b[i].ring, rings ? a[i].ring : 0);
+    EXPECT_EQ(b[i].dt, times ? a[i].dt : 0.0f);
   }
-  in.flags = adit::FeatureSet::kDeskewImu | adit::FeatureSet::kEmptyRing;
-  in.points_in = 60;
-  in.removed_invalid = 4;
-  in.removed_range = 3;
-  in.removed_outlier = 3;
-  const adit::FeatureSet out = adit::msg::fromMessage(throughBytes(adit::msg::toMessage(in)));
-  EXPECT_EQ(out.utime, in.utime);
+}
+}  // namespace
+
+TEST(Messages, FeatureSetRoundTrip) {
+  for (const bool deskewed : {true, false}) {
+    adit::FeatureSet in;
+    in.utime = 5'000'000;
+    in.cloud = makeScan(50);
+    in.cloud.deskewed = deskewed;
+    in.corner_sharp = makeScan(3).points;
+    in.corner_less_sharp = makeScan(6).points;
+    in.surf_flat = makeScan(4).points;
+    in.surf_less_flat = makeScan(9).points;
+    for (int k = 0; k < 7; ++k) {
+      in.keypoints.emplace_back(1.0f * k, 2.0f, -3.0f);
+      adit::LinK3dDescriptor d{};
+      d[static_cast<std::size_t>(k * 10)] = 1.5f + 0.1234f * k;
+      in.descriptors.push_back(d);
+    }
+    in.flags = adit::FeatureSet::kDeskewImu | adit::FeatureSet::kEmptyRing;
+    in.points_in = 60;
+    in.removed_invalid = 4;
+    in.removed_range = 3;
+    in.removed_outlier = 3;
+    const adit::FeatureSet out = adit::msg::fromMessage(throughBytes(adit::msg::toMessage(in)));
+    EXPECT_EQ(out.utime, in.utime);
+    EXPECT_EQ(out.cloud.deskewed, deskewed);
+    EXPECT_EQ(out.cloud.sensor, "vlp16");
+    EXPECT_EQ(out.cloud.num_beams, 16);
+    expectLeanPoints(in.cloud.points, out.cloud.points, false, !deskewed);
+    expectLeanPoints(in.corner_sharp, out.corner_sharp, true, !deskewed);
+    expectLeanPoints(in.corner_less_sharp, out.corner_less_sharp, true, !deskewed);
+    expectLeanPoints(in.surf_flat, out.surf_flat, true, !deskewed);
+    expectLeanPoints(in.surf_less_flat, out.surf_less_flat, true, !deskewed);
+    EXPECT_EQ(out.keypoints, in.keypoints);
+    ASSERT_EQ(out.descriptors.size(), in.descriptors.size());
+    for (std::size_t k = 0; k < in.descriptors.size(); ++k)
+      for (std::size_t b = 0; b < in.descriptors[k].size(); ++b) {
+        EXPECT_NEAR(out.descriptors[k][b], in.descriptors[k][b], 0.5f * adit::msg::kDescriptorScale + 1e-6f);
+        EXPECT_EQ(out.descriptors[k][b] == 0.0f, in.descriptors[k][b] == 0.0f);
+      }
+    EXPECT_EQ(out.flags, in.flags);
+    EXPECT_EQ(out.points_in, 60);
+    EXPECT_EQ(out.removed_invalid + out.removed_range + out.removed_outlier, 10);
+  }
+}
+
+TEST(Messages, OdometryCarriesOnlyTheSetsTheMapperNeeds) {
+  adit::FeatureSet f;
+  f.cloud = makeScan(20);
+  f.cloud.deskewed = true;
+  f.corner_sharp = makeScan(3).points;  // odometry-only: never on ODOM_SCAN
+  f.corner_less_sharp = makeScan(6).points;
+  f.surf_less_flat = makeScan(9).points;
+  adit::odometry_t m = throughBytes(adit::msg::toMessage(adit::PoseEstimate{}, &f));
+  const adit::FeatureSet out = adit::msg::featuresOf(m);
   EXPECT_TRUE(out.cloud.deskewed);
-  expectSamePoints(in.cloud.points, out.cloud.points);
-  expectSamePoints(in.corner_sharp, out.corner_sharp);
-  expectSamePoints(in.corner_less_sharp, out.corner_less_sharp);
-  expectSamePoints(in.surf_flat, out.surf_flat);
-  expectSamePoints(in.surf_less_flat, out.surf_less_flat);
-  EXPECT_EQ(out.keypoints, in.keypoints);
-  EXPECT_EQ(out.descriptors, in.descriptors);
-  EXPECT_EQ(out.flags, in.flags);
-  EXPECT_EQ(out.points_in, 60);
-  EXPECT_EQ(out.removed_invalid + out.removed_range + out.removed_outlier, 10);
+  EXPECT_TRUE(out.corner_sharp.empty());
+  expectLeanPoints(f.corner_less_sharp, out.corner_less_sharp, false, false);
+  expectLeanPoints(f.surf_less_flat, out.surf_less_flat, false, false);
+  expectLeanPoints(f.cloud.points, out.cloud.points, false, false);
+  adit::msg::stripPoints(m);
+  EXPECT_EQ(m.corners.num_points + m.surfaces.num_points + m.cloud.num_points, 0);
+  EXPECT_LT(m.getEncodedSize(), 600);  // the pose alone: what the LAN and replay's output carry
 }
 
 TEST(Messages, OdometryRoundTripKeepsPoseAndCovariance) {
