@@ -32,7 +32,7 @@ TEST(Resume, LoopCloserStateRoundTripsExactly) {
   adit::LoopCloser closer;
   for (int k = 0; k < 12; ++k) {
     const adit::odometry_t m = adit::test::mappedMessage(k);
-    closer.process(adit::msg::fromMessage(m), adit::msg::fromMessage(m.features.cloud));
+    closer.process(adit::msg::fromMessage(m), adit::msg::featuresOf(m).cloud);
   }
   const std::string bytes = closer.saveState();
   std::vector<std::string> records;
