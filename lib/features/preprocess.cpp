@@ -179,6 +179,8 @@ std::vector<LidarPoint> voxelDownsample(const std::vector<LidarPoint>& points, f
   const float inv = 1.0f / leaf;
   for (const LidarPoint& p : points) {
     const Eigen::Array3f q = (p.p.array() * inv).floor();
+    // Non-finite or absurd coordinates (a hostile message) have no voxel: converting them to int64 is undefined.
+    if (!q.allFinite() || (q.abs() > 1e15f).any()) continue;
     const std::uint64_t key = ((static_cast<std::uint64_t>(static_cast<std::int64_t>(q.x())) & 0x1FFFFF) << 42) |
                               ((static_cast<std::uint64_t>(static_cast<std::int64_t>(q.y())) & 0x1FFFFF) << 21) |
                               (static_cast<std::uint64_t>(static_cast<std::int64_t>(q.z())) & 0x1FFFFF);

@@ -7,8 +7,6 @@
 #include "eval/report.hpp"
 #include "eval/trajectory_io.hpp"
 
-#include <spdlog/spdlog.h>
-
 #include <iostream>
 #include <memory>
 #include <string>
@@ -94,7 +92,7 @@ void registerEvalCommand(CLI::App& app) {
     try {
       code = runEval(*o);
     } catch (const std::exception& e) {
-      spdlog::error("{}", e.what());
+      std::cerr << "error adit eval: " << e.what() << "\n";
       code = 1;
     }
     if (code != 0) throw CLI::RuntimeError(code);
