@@ -178,7 +178,8 @@ std::vector<LidarPoint> voxelDownsample(const std::vector<LidarPoint>& points, f
   std::vector<int> counts;
   const float inv = 1.0f / leaf;
   for (const LidarPoint& p : points) {
-    const Eigen::Array3f q = (p.p.array() * inv).floor();
+    // Clamped so that the cast cannot overflow (a tiny leaf or a far point); the key keeps 21 bits anyway.
+    const Eigen::Array3f q = (p.p.array() * inv).floor().max(-1e15f).min(1e15f);
     const std::uint64_t key = ((static_cast<std::uint64_t>(static_cast<std::int64_t>(q.x())) & 0x1FFFFF) << 42) |
                               ((static_cast<std::uint64_t>(static_cast<std::int64_t>(q.y())) & 0x1FFFFF) << 21) |
                               (static_cast<std::uint64_t>(static_cast<std::int64_t>(q.z())) & 0x1FFFFF);

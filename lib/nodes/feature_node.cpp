@@ -3,6 +3,7 @@
 #include "features/feature_extractor.hpp"
 #include "msg/convert.hpp"
 #include "nodes/imu_buffer.hpp"
+#include "nodes/node_config.hpp"
 
 #include <deque>
 
@@ -15,9 +16,8 @@ class FeatureNode : public runtime::Node {
       : Node("feature"),
         extractor_(featureConfigFrom(config)),
         // IMU older than a sweep plus this margin is of no further use to deskewing.
-        imu_(config.get<double>("features.node.imu_keep_s", 0.5)) {
-    // An odometry pose older than this (s) before a sweep is too stale to predict its motion.
-    max_prior_age_s_ = config.get<double>("features.node.max_prior_age_s", 0.3);
+        imu_(featureNodeConfigTable().read(config).imu_keep_s) {
+    max_prior_age_s_ = featureNodeConfigTable().read(config).max_prior_age_s;
     subscribe<adit::point_cloud_t>("points", "LIDAR_POINTS", [this](const adit::point_cloud_t& m) { onSweep(m); });
     subscribe<adit::imu_t>("imu", "IMU", [this](const adit::imu_t& m) { imu_.add(m); });
     subscribe<adit::odometry_t>("odometry", "ODOM_SCAN", [this](const adit::odometry_t& m) { onOdometry(m); });

@@ -6,6 +6,7 @@
 #include "loop/loop_closer.hpp"
 #include "loop/pose_graph.hpp"
 #include "msg/convert.hpp"
+#include "nodes/node_config.hpp"
 #include "nodes/products.hpp"
 
 #include <adit/pose_graph_t.hpp>
@@ -19,7 +20,7 @@ class LoopCloserNode : public runtime::Node, public WritesProducts {
  public:
   explicit LoopCloserNode(const Config& config)
       : Node("loop_closer"), closer_(loopCloserConfigFrom(config)),
-        map_voxel_(config.get<double>("loop.map_voxel", 0.1)) {
+        map_voxel_(loopCloserNodeConfigTable().read(config).map_voxel) {
     subscribe<adit::odometry_t>("mapped", "ODOM_MAPPED", [this](const adit::odometry_t& m) { onMapped(m); });
     advertise("loop", "LOOP_CLOSURE");
     advertise("graph", "POSE_GRAPH");

@@ -6,6 +6,7 @@
 #include "features/preprocess.hpp"
 #include "mapping/scan_to_map.hpp"
 #include "msg/convert.hpp"
+#include "nodes/node_config.hpp"
 #include "nodes/products.hpp"
 
 #include <adit/command_t.hpp>
@@ -21,11 +22,11 @@ class MapperNode : public runtime::Node, public WritesProducts {
  public:
   explicit MapperNode(const Config& config)
       : Node("mapper"), mapper_(mapperConfigFrom(config)),
-        map_voxel_(config.get<double>("mapping.node.map_voxel", 0.1)),
-        map_path_(config.get<std::string>("mapping.node.map_path", "")),
+        map_voxel_(mapperNodeConfigTable().read(config).map_voxel),
+        map_path_(mapperNodeConfigTable().read(config).map_path),
         // ODOM_MAPPED carries the sweep for the loop closer's keyframes, which it thins to 0.2 m itself
         // (loop.keyframe_voxel); keep this at or below that. 0 = forward it whole.
-        forward_voxel_(config.get<double>("mapping.node.forward_cloud_voxel", 0.2)) {
+        forward_voxel_(mapperNodeConfigTable().read(config).forward_cloud_voxel) {
     subscribe<adit::odometry_t>("odometry", "ODOM_SCAN", [this](const adit::odometry_t& m) { onOdometry(m); });
     subscribe<adit::pose_graph_t>("graph", "POSE_GRAPH", [this](const adit::pose_graph_t& m) { onGraph(m); },
                                   runtime::InputKind::Events);

@@ -3,6 +3,7 @@
 #include "features/preprocess.hpp"
 #include "msg/convert.hpp"
 #include "nodes/imu_buffer.hpp"
+#include "nodes/node_config.hpp"
 #include "odometry/initial_guess.hpp"
 #include "odometry/scan_to_scan.hpp"
 
@@ -18,10 +19,10 @@ class OdometryNode : public runtime::Node {
       : Node("odometry"),
         odometry_(scanToScanConfigFrom(config)),
         guess_config_(initialGuessConfigFrom(config)),
-        imu_(config.get<double>("odometry.node.imu_keep_s", 1.0)) {
+        imu_(odometryNodeConfigTable().read(config).imu_keep_s) {
     // The sweep forwarded on ODOM_SCAN feeds only the mapper's global map (itself at 0.1 m): thin it to
     // that resolution so the bus and the logs carry a third of the bytes. 0 = forward it whole.
-    forward_voxel_ = config.get<double>("odometry.node.forward_cloud_voxel", 0.1);
+    forward_voxel_ = odometryNodeConfigTable().read(config).forward_cloud_voxel;
     subscribe<adit::features_t>("features", "FEATURES", [this](const adit::features_t& m) { onFeatures(m); });
     subscribe<adit::imu_t>("imu", "IMU", [this](const adit::imu_t& m) { imu_.add(m); });
     advertise("odometry", "ODOM_SCAN");
