@@ -23,6 +23,8 @@
 #include <Eigen/Core>
 
 #include <cmath>
+#include <cstdint>
+#include <type_traits>
 #include <functional>
 #include <limits>
 #include <string>
@@ -80,7 +82,9 @@ T readNumber(const Config& c, const std::string& key, const std::string& text, c
   } catch (const std::runtime_error&) {
     fail(c, key, text, std::string("is not ") + (Kind<T>::integer ? "an integer" : "a number"), allowed);
   }
-  if (!range.contains(static_cast<double>(value))) fail(c, key, text, "is out of range", allowed);
+  ConfigRange bounds = range;  // a float field is compared with its bounds as floats (0.01f < 0.01)
+  if constexpr (std::is_same_v<T, float>) bounds.lo = static_cast<float>(bounds.lo), bounds.hi = static_cast<float>(bounds.hi);
+  if (!bounds.contains(static_cast<double>(value))) fail(c, key, text, "is out of range", allowed);
   return value;
 }
 
