@@ -81,8 +81,15 @@ TEST(ConfigFiles, LaunchFilesLoad) {
   for (const auto& path : yamlFiles(kLaunch)) {
     if (path.string().find(".launch.yaml") == std::string::npos) continue;
     ++files;
-    EXPECT_NO_THROW(adit::launch::loadLaunchFile(path.string(), {{"LOG", "run.lcmlog"}, {"RUN_DIR", "run"}}))
-        << path.filename();
+    adit::launch::LaunchSpec spec;
+    const std::map<std::string, std::string> vars{{"LOG", "run.lcmlog"}, {"RUN_DIR", "run"}, {"ADIT_ROOT", ADIT_SOURCE_DIR}};
+    ASSERT_NO_THROW(spec = adit::launch::loadLaunchFile(path.string(), vars)) << path.filename();
+    for (const auto& process : spec.processes)  // the configuration files its processes are given load too
+      for (std::size_t i = 0; i + 1 < process.command.size(); ++i)
+        if (process.command[i] == "--config") {
+          EXPECT_NO_THROW(adit::nodes::validatePipelineConfig(adit::Config::fromYamlFile(process.command[i + 1])))
+              << path.filename() << " " << process.name << ": " << process.command[i + 1];
+        }
   }
   EXPECT_GE(files, 3);
 }
