@@ -29,7 +29,7 @@ Config Config::fromYamlString(const std::string& text) {
   try {
     flatten(YAML::Load(text), "", c.values_);
   } catch (const YAML::Exception& e) {
-    throw std::runtime_error(std::string("config: invalid YAML: ") + e.what());
+    throw ConfigError(std::string("config: invalid YAML: ") + e.what());
   }
   return c;
 }
@@ -38,16 +38,22 @@ Config Config::fromYamlFile(const std::string& path) {
   Config c;
   try {
     flatten(YAML::LoadFile(path), "", c.values_);
+    for (const auto& kv : c.values_) c.origins_[kv.first] = path;
   } catch (const YAML::BadFile&) {
-    throw std::runtime_error("config: cannot read '" + path + "'");
+    throw ConfigError("config: cannot read '" + path + "'");
   } catch (const YAML::Exception& e) {
-    throw std::runtime_error("config: invalid YAML in '" + path + "': " + e.what());
+    throw ConfigError("config: invalid YAML in '" + path + "': " + e.what());
   }
   return c;
 }
 
 void Config::merge(const Config& other) {
-  for (const auto& kv : other.values_) values_[kv.first] = kv.second;
+  for (const auto& kv : other.values_) {
+    values_[kv.first] = kv.second;
+    const auto origin = other.origins_.find(kv.first);
+    if (origin != other.origins_.end()) origins_[kv.first] = origin->second;
+    else origins_.erase(kv.first);
+  }
 }
 
 }  // namespace adit

@@ -10,6 +10,13 @@
 
 namespace adit {
 
+// A configuration file or value that cannot be used: the message names the key, the value, the file and
+// what is allowed. Processes and `adit` exit with status 2 on it.
+class ConfigError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
 class Config {
  public:
   Config() = default;
@@ -21,7 +28,15 @@ class Config {
   void merge(const Config& other);
 
   bool has(const std::string& key) const { return values_.count(key) > 0; }
-  void set(const std::string& key, const std::string& value) { values_[key] = value; }
+  // The file a key was read from ("" when set in code or from a string).
+  std::string originOf(const std::string& key) const {
+    auto it = origins_.find(key);
+    return it == origins_.end() ? std::string() : it->second;
+  }
+  void set(const std::string& key, const std::string& value) {
+    values_[key] = value;
+    origins_.erase(key);
+  }
   const std::map<std::string, std::string>& values() const { return values_; }
 
   // Typed read with a default; throws std::runtime_error if the value does not parse as T.
@@ -53,7 +68,7 @@ class Config {
   // is absent), for `adit config --defaults` and the check that launch/config files name only real keys.
   void recordReadsInto(std::map<std::string, std::string>* reads) const { reads_ = reads; }
 
- private:
+  // Text -> T (throws std::runtime_error if it does not parse) and T -> text, as get() does.
   template <class T>
   static T parse(const std::string& key, const std::string& text) {
     if constexpr (std::is_same_v<T, std::string>) {
@@ -63,6 +78,8 @@ class Config {
       if (text == "false" || text == "False" || text == "0" || text == "no" || text == "off") return false;
       throw std::runtime_error("config: '" + key + "' = '" + text + "' is not a boolean");
     } else {
+      if (std::is_unsigned_v<T> && text.find('-') != std::string::npos)
+        throw std::runtime_error("config: '" + key + "' = '" + text + "' is not a valid number");
       std::istringstream in(text);
       T value{};
       in >> value;
@@ -83,7 +100,10 @@ class Config {
       return out.str();
     }
   }
+
+ private:
   std::map<std::string, std::string> values_;
+  std::map<std::string, std::string> origins_;  // key -> file it came from
   mutable std::map<std::string, std::string>* reads_ = nullptr;  // not owned; null = not recording
 };
 

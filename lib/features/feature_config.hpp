@@ -1,9 +1,9 @@
 // Configuration of the feature stage (preprocessing, deskew, LOAM features, LinK3D), with documented defaults.
-// Every field can be set from the YAML config through the dotted key named in its comment
-// (see featureConfigFrom). Defaults are tuned for 16-beam spinning lidars (VLP-16 / RS-16) in roadways.
+// Every field can be set from the YAML config through the dotted key named in its comment; the keys, ranges
+// and one-line docs are in featureConfigTable() (feature_config.cpp). Defaults are tuned for 16-beam spinning lidars (VLP-16 / RS-16) in roadways.
 #pragma once
 
-#include "core/config.hpp"
+#include "core/config_table.hpp"
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
@@ -57,7 +57,9 @@ struct DeskewConfig {
   // features.deskew.enabled: false leaves points where they were measured.
   bool enabled = true;
   // features.deskew.imu_rotation_rpy_deg ([roll, pitch, yaw], deg): rotation R_lidar_imu taking IMU-frame
-  // vectors into the lidar frame. Identity by default (IMU mounted aligned with the lidar).
+  // vectors into the lidar frame. Identity by default (IMU mounted aligned with the lidar). featureConfigFrom
+  // sets R_lidar_imu from imu_rotation_rpy_deg.
+  Eigen::Vector3f imu_rotation_rpy_deg = Eigen::Vector3f::Zero();
   Eigen::Quaterniond R_lidar_imu = Eigen::Quaterniond::Identity();
   // features.deskew.table_steps: poses precomputed across the sweep; points interpolate between them.
   // 32 steps = 3 ms apart at 10 Hz, far finer than the motion changes.
@@ -179,7 +181,11 @@ struct FeatureConfig {
   RansacConfig ransac;
 };
 
-// Reads keys "features.<group>.<field>" (see the field comments); missing keys keep the defaults.
+// Keys "features.<group>.<field>" with type, range, unit and doc.
+const ConfigTable<FeatureConfig>& featureConfigTable();
+// Reads and validates the keys (throws ConfigError); missing keys keep the defaults.
 FeatureConfig featureConfigFrom(const Config& c);
+// R_lidar_imu from roll, pitch, yaw in degrees (as the key imu_rotation_rpy_deg gives them).
+Eigen::Quaterniond rotationFromRpyDeg(const Eigen::Vector3f& rpy_deg);
 
 }  // namespace adit

@@ -20,6 +20,7 @@ bool azimuthGap(const Eigen::Vector3f& a, const Eigen::Vector3f& b, float sin_ma
 // as less edge-like. Windows crossing a gap of missing returns are not evaluated.
 void scoreRing(const RingCloud& c, int b, int e, const LoamConfig& cfg, PointScores& s) {
   const int w = cfg.half_window, n = e - b;
+  if (w < 1 || w >= n) return;  // no complete window (a half_window < 1 would index before the ring)
   const float sin_max = std::sin(std::min(cfg.max_neighbor_gap_deg, 89.0f) * static_cast<float>(M_PI / 180.0));
   std::vector<int> gaps(n, 0);           // gaps[k]: gaps between consecutive points among b..b+k
   std::vector<Eigen::Vector3d> P(n + 1);  // P[k] = sum of the first k points
@@ -66,7 +67,7 @@ float medianNoise(std::vector<float>& second) {
 
 // Marks the far side of depth jumps and beam-parallel points as unusable.
 void markUnreliable(int b, int e, const LoamConfig& cfg, PointScores& s) {
-  const int w = cfg.half_window;
+  const int w = std::clamp(cfg.half_window, 0, e - b);  // i + 1 + w must not overflow
   for (int i = b; i + 1 < e; ++i) {
     const float d0 = s.range[i], d1 = s.range[i + 1];
     if (d0 - d1 > cfg.occlusion_ratio * d1) {  // i lies behind the edge at i + 1

@@ -11,7 +11,7 @@
 // Roadways are repetitive: a false loop is worse than a missed one, and the defaults lean that way.
 #pragma once
 
-#include "core/config.hpp"
+#include "core/config_table.hpp"
 #include "core/types.hpp"
 #include "loop/loop_verifier.hpp"
 #include "loop/odometry_chain.hpp"
@@ -72,7 +72,9 @@ struct LoopCloserConfig {
   PoseGraphConfig graph;
 };
 
-LoopCloserConfig loopCloserConfigFrom(const Config& config);  // keys "loop.<field>", see README
+// Keys "loop.<field>" (see README); reading validates them (throws ConfigError).
+const ConfigTable<LoopCloserConfig>& loopCloserConfigTable();
+LoopCloserConfig loopCloserConfigFrom(const Config& config);
 
 struct LoopCloserStats {
   int sweeps = 0;

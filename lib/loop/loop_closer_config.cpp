@@ -1,66 +1,86 @@
-// Reads LoopCloserConfig from dotted keys "loop.*"; every default is the one documented in the headers.
+// The loop closer's keys "loop.*": one line each (key, field, allowed range, unit, doc); see core/config_table.hpp.
 #include "loop/loop_closer.hpp"
 
 namespace adit {
 namespace {
 
-template <class T>
-void read(const Config& c, const std::string& key, T& field) {
-  field = c.get<T>("loop." + key, field);
+ConfigTable<ScanContextConfig> scanContextTable() {
+  using C = ScanContextConfig;
+  ConfigTable<C> t("loop.scan_context");
+  t.add("max_range", &C::max_range, above(0), "m", "radial extent of the polar grid")
+   .add("min_range", &C::min_range, atLeast(0), "m", "nearer points (robot, mount) are ignored")
+   .add("rings", &C::rings, between(1, 1000), "", "annuli over [0, max_range)")
+   .add("sectors", &C::sectors, between(1, 3600), "", "azimuth sectors, also the yaw resolution of a match")
+   .add("height_offset", &C::height_offset, anyValue(), "m", "added to point heights so occupied bins are > 0")
+   .add("shift_search_radius", &C::shift_search_radius, between(0, 1800), "sectors", "half-width of the fine column-shift search");
+  return t;
+}
+
+ConfigTable<LoopVerifierConfig> verifierTable() {
+  using V = LoopVerifierConfig;
+  using I = IcpConfig;
+  ConfigTable<I> icp("loop.verifier.icp");
+  icp.add("max_iterations", &I::max_iterations, between(1, 1000), "", "Gauss-Newton iterations per ICP phase")
+     .add("coarse_correspondence_distance", &I::coarse_correspondence_distance, above(0), "m", "correspondence gate of the coarse phase")
+     .add("fine_correspondence_distance", &I::fine_correspondence_distance, above(0), "m", "correspondence gate of the fine phase")
+     .add("inlier_residual", &I::inlier_residual, above(0), "m", "point-to-plane residual below which a point is an inlier")
+     .add("normal_neighbors", &I::normal_neighbors, between(3, 1000), "points", "neighbours per target normal")
+     .add("max_surface_variation", &I::max_surface_variation, between(0, 1), "", "largest surface variation of a planar target point")
+     .add("characteristic_length", &I::characteristic_length, above(0), "m", "puts rotations and translations on one scale for the eigenvalue test");
+  ConfigTable<V> t("loop.verifier");
+  t.add("submap_neighbors", &V::submap_neighbors, between(0, 1000), "keyframes", "keyframes each side of the candidate merged into its submap")
+   .add("submap_voxel", &V::submap_voxel, between(0.01, 100), "m", "voxel of the submap (ICP target)")
+   .add("query_voxel", &V::query_voxel, between(0.01, 100), "m", "voxel of the query cloud (ICP source)")
+   .add("max_rms", &V::max_rms, above(0), "m", "largest RMS point-to-plane residual of an accepted fit")
+   .add("min_inlier_ratio", &V::min_inlier_ratio, between(0, 1), "", "smallest share of query points that are inliers")
+   .add("min_eigenvalue_ratio", &V::min_eigenvalue_ratio, between(0, 1), "", "smallest / largest ICP Hessian eigenvalue: below, a direction is unconstrained")
+   .nest(&V::icp, icp);
+  return t;
+}
+
+ConfigTable<PoseGraphConfig> graphTable() {
+  using G = PoseGraphConfig;
+  ConfigTable<G> t("loop.graph");
+  t.add("max_iterations", &G::max_iterations, between(1, 10000), "", "Levenberg-Marquardt iterations per optimisation")
+   .add("loop_loss_scale", &G::loop_loss_scale, above(0), "sigma", "Cauchy scale of loop edges in loop standard deviations");
+  return t;
 }
 
 }  // namespace
 
-LoopCloserConfig loopCloserConfigFrom(const Config& c) {
-  LoopCloserConfig k;
-  read(c, "keyframe_distance", k.keyframe_distance);
-  read(c, "keyframe_angle_deg", k.keyframe_angle_deg);
-  read(c, "keyframe_voxel", k.keyframe_voxel);
-  read(c, "level_scan_context", k.level_scan_context);
-
-  read(c, "scan_context.max_range", k.scan_context.max_range);
-  read(c, "scan_context.min_range", k.scan_context.min_range);
-  read(c, "scan_context.rings", k.scan_context.rings);
-  read(c, "scan_context.sectors", k.scan_context.sectors);
-  read(c, "scan_context.height_offset", k.scan_context.height_offset);
-  read(c, "scan_context.shift_search_radius", k.scan_context.shift_search_radius);
-  read(c, "candidates", k.candidates);
-  read(c, "max_scan_context_distance", k.max_scan_context_distance);
-  read(c, "max_verifications", k.max_verifications);
-  read(c, "exclude_recent_keyframes", k.exclude_recent_keyframes);
-  read(c, "exclude_recent_seconds", k.exclude_recent_seconds);
-  read(c, "cooldown_keyframes", k.cooldown_keyframes);
-
-  LoopVerifierConfig& v = k.verifier;
-  read(c, "verifier.submap_neighbors", v.submap_neighbors);
-  read(c, "verifier.submap_voxel", v.submap_voxel);
-  read(c, "verifier.query_voxel", v.query_voxel);
-  read(c, "verifier.max_rms", v.max_rms);
-  read(c, "verifier.min_inlier_ratio", v.min_inlier_ratio);
-  read(c, "verifier.min_eigenvalue_ratio", v.min_eigenvalue_ratio);
-  read(c, "verifier.icp.max_iterations", v.icp.max_iterations);
-  read(c, "verifier.icp.coarse_correspondence_distance", v.icp.coarse_correspondence_distance);
-  read(c, "verifier.icp.fine_correspondence_distance", v.icp.fine_correspondence_distance);
-  read(c, "verifier.icp.inlier_residual", v.icp.inlier_residual);
-  read(c, "verifier.icp.normal_neighbors", v.icp.normal_neighbors);
-  read(c, "verifier.icp.max_surface_variation", v.icp.max_surface_variation);
-  read(c, "verifier.icp.characteristic_length", v.icp.characteristic_length);
-
-  read(c, "odometry_translation_sigma", k.odometry_translation_sigma);
-  read(c, "odometry_rotation_sigma", k.odometry_rotation_sigma);
-  read(c, "odometry_min_translation_sigma", k.odometry_min_translation_sigma);
-  read(c, "odometry_min_rotation_sigma", k.odometry_min_rotation_sigma);
-  read(c, "use_mapper_covariance", k.use_mapper_covariance);
-  read(c, "loop_translation_sigma", k.loop_translation_sigma);
-  read(c, "loop_rotation_sigma", k.loop_rotation_sigma);
-  read(c, "max_odometry_chi2", k.max_odometry_chi2);
-  read(c, "min_consistent_loops", k.min_consistent_loops);
-  read(c, "consistency_window", k.consistency_window);
-  read(c, "max_pair_chi2", k.max_pair_chi2);
-
-  read(c, "graph.max_iterations", k.graph.max_iterations);
-  read(c, "graph.loop_loss_scale", k.graph.loop_loss_scale);
-  return k;
+const ConfigTable<LoopCloserConfig>& loopCloserConfigTable() {
+  using K = LoopCloserConfig;
+  static const ConfigTable<K> table = [] {
+    ConfigTable<K> t("loop");
+    t.add("keyframe_distance", &K::keyframe_distance, above(0), "m", "mapped motion between keyframes")
+     .add("keyframe_angle_deg", &K::keyframe_angle_deg, above(0), "deg", "mapped rotation between keyframes")
+     .add("keyframe_voxel", &K::keyframe_voxel, between(0.01, 100), "m", "voxel of the cloud kept per keyframe")
+     .add("level_scan_context", &K::level_scan_context, anyValue(), "", "build Scan Context in a gravity-levelled frame")
+     .nest(&K::scan_context, scanContextTable())
+     .add("candidates", &K::candidates, between(1, 1000), "", "ring-key neighbours ranked per query")
+     .add("max_scan_context_distance", &K::max_scan_context_distance, between(0, 1), "", "candidates below this distance are verified")
+     .add("max_verifications", &K::max_verifications, between(0, 1000), "", "best candidates verified by ICP per keyframe")
+     .add("exclude_recent_keyframes", &K::exclude_recent_keyframes, between(0, 1000000), "keyframes", "never match the newest N keyframes")
+     .add("exclude_recent_seconds", &K::exclude_recent_seconds, atLeast(0), "s", "nor those from the last T seconds")
+     .add("cooldown_keyframes", &K::cooldown_keyframes, between(0, 1000000), "keyframes", "after an accepted loop, skip detection this long")
+     .nest(&K::verifier, verifierTable())
+     .add("odometry_translation_sigma", &K::odometry_translation_sigma, above(0), "m/sqrt(m)", "odometry step noise added per sqrt of metres travelled")
+     .add("odometry_rotation_sigma", &K::odometry_rotation_sigma, above(0), "rad/sqrt(m)", "same for rotation")
+     .add("odometry_min_translation_sigma", &K::odometry_min_translation_sigma, above(0), "m", "floor of the step noise per keyframe step")
+     .add("odometry_min_rotation_sigma", &K::odometry_min_rotation_sigma, above(0), "rad", "same for rotation")
+     .add("use_mapper_covariance", &K::use_mapper_covariance, anyValue(), "", "add the mapper's per-sweep covariances of the step")
+     .add("loop_translation_sigma", &K::loop_translation_sigma, above(0), "m", "noise of a verified loop measurement")
+     .add("loop_rotation_sigma", &K::loop_rotation_sigma, above(0), "rad", "same for rotation")
+     .add("max_odometry_chi2", &K::max_odometry_chi2, above(0), "", "Mahalanobis gate of a loop against the odometry (6 dof; 22.46 = 99.9 %)")
+     .add("min_consistent_loops", &K::min_consistent_loops, between(1, 100), "", "mutually consistent loops needed (2: never trust one match)")
+     .add("consistency_window", &K::consistency_window, between(0, 1000000), "keyframes", "window in which loops must agree")
+     .add("max_pair_chi2", &K::max_pair_chi2, above(0), "", "pairwise consistency gate (chi-square, 6 dof)")
+     .nest(&K::graph, graphTable());
+    return t;
+  }();
+  return table;
 }
+
+LoopCloserConfig loopCloserConfigFrom(const Config& c) { return loopCloserConfigTable().read(c); }
 
 }  // namespace adit

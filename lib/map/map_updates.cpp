@@ -5,16 +5,22 @@
 
 namespace adit {
 
-MapUpdateConfig mapUpdateConfigFrom(const Config& c) {
-  MapUpdateConfig m;
-  m.period_s = c.get<double>("map.update_period_s", m.period_s);
-  m.voxel_m = c.get<double>("map.update_voxel_m", m.voxel_m);
-  m.move_threshold_m = c.get<double>("map.update_move_m", m.move_threshold_m);
-  m.move_threshold_deg = c.get<double>("map.update_move_deg", m.move_threshold_deg);
-  m.max_points = c.get<int>("map.update_max_points", m.max_points);
-  m.max_moved = c.get<int>("map.update_max_moved", m.max_moved);
-  return m;
+const ConfigTable<MapUpdateConfig>& mapUpdateConfigTable() {
+  using M = MapUpdateConfig;
+  static const ConfigTable<M> table = [] {
+    ConfigTable<M> t("map");
+    t.add("update_period_s", &M::period_s, above(0), "s", "least sensor time between two MAP_UPDATE messages")
+     .add("update_voxel_m", &M::voxel_m, aboveUpTo(0, 100), "m", "decimation of a submap's points for viewers")
+     .add("update_move_m", &M::move_threshold_m, atLeast(0), "m", "a submap moved less than this (and the angle) is not resent")
+     .add("update_move_deg", &M::move_threshold_deg, atLeast(0), "deg", "a submap turned less than this (and the distance) is not resent")
+     .add("update_max_points", &M::max_points, between(1, 10000000), "", "points per update; more new submaps wait for the next")
+     .add("update_max_moved", &M::max_moved, between(1, 10000000), "", "moved poses per update; more wait for the next");
+    return t;
+  }();
+  return table;
 }
+
+MapUpdateConfig mapUpdateConfigFrom(const Config& c) { return mapUpdateConfigTable().read(c); }
 
 std::optional<MapUpdate> MapUpdateTracker::update(std::int64_t utime, const LoopCloser& closer) {
   if (last_utime_ >= 0 && utime - last_utime_ < toUtime(config_.period_s)) return std::nullopt;

@@ -5,7 +5,7 @@
 // bandwidth is bounded whatever the pose graph does.
 #pragma once
 
-#include "core/config.hpp"
+#include "core/config_table.hpp"
 #include "loop/loop_closer.hpp"
 
 #include <optional>
@@ -21,6 +21,8 @@ struct MapUpdateConfig {
   int max_points = 40000;           // map.update_max_points: points per update; more new submaps wait
   int max_moved = 5000;             // map.update_max_moved: moved poses per update; more wait
 };
+// Keys "map.*" (MAP_UPDATE's rate and decimation), read through this table.
+const ConfigTable<MapUpdateConfig>& mapUpdateConfigTable();
 MapUpdateConfig mapUpdateConfigFrom(const Config& config);
 
 struct SubmapPose {

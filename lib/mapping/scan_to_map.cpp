@@ -4,6 +4,7 @@
 #include "odometry/feature_fit.hpp"
 #include "odometry/motion_compensation.hpp"
 #include "odometry/pose_increment.hpp"
+#include "odometry/scan_to_scan.hpp"
 
 namespace adit {
 namespace {
@@ -32,23 +33,32 @@ MapperConfig aloamMapperConfig() {
   return m;
 }
 
+const ConfigTable<MapperConfig>& mapperConfigTable() {
+  using M = MapperConfig;
+  static const ConfigTable<M> table = [] {
+    ConfigTable<M> t("mapping");
+    t.nest(&M::registration, registrationConfigTable("mapping"))
+     .add("outer_iterations", &M::outer_iterations, between(1, 100), "", "correspondence rounds per sweep (A-LOAM: 2)")
+     .add("corner_resolution_m", &M::corner_resolution_m, between(0.01, 10), "m", "resolution of edge points in the sweep and the map")
+     .add("surf_resolution_m", &M::surf_resolution_m, between(0.01, 10), "m", "resolution of surface points in the sweep and the map")
+     .add("map_voxel_size_m", &M::map_voxel_size_m, between(0.05, 100), "m", "local-map voxel edge, also the largest exact neighbour-search radius")
+     .add("max_points_per_voxel", &M::max_points_per_voxel, between(1, 100000), "points", "density bound of a local-map voxel")
+     .add("neighbours", &M::neighbours, between(3, 100), "points", "neighbours per feature (A-LOAM: 5)")
+     .add("max_neighbour_distance_m", &M::max_neighbour_distance_m, above(0), "m", "farthest neighbour accepted (A-LOAM: 1)")
+     .add("line_eigen_ratio", &M::line_eigen_ratio, atLeast(1), "", "edge if the largest eigenvalue exceeds ratio * the second (A-LOAM: 3)")
+     .add("plane_max_point_distance_m", &M::plane_max_point_distance_m, above(0), "m", "a plane is rejected if a neighbour is farther (A-LOAM: 0.2)")
+     .add("local_map_radius_m", &M::local_map_radius_m, above(0), "m", "map points farther from the robot are dropped (bounds memory)")
+     .add("global_map_resolution_m", &M::global_map_resolution_m, between(0.01, 100), "m", "resolution of the saved global map")
+     .add("global_map_max_range_m", &M::global_map_max_range_m, above(0), "m", "range of the sweep points folded into the global map")
+     .add("compensate_raw_sweeps", &M::compensate_raw_sweeps, anyValue(), "", "compensate raw sweeps with the odometry motion before they enter the map");
+    return t;
+  }();
+  return table;
+}
+
 MapperConfig mapperConfigFrom(const Config& c) {
-  MapperConfig m = c.get<bool>("ablation.aloam", false) ? aloamMapperConfig() : MapperConfig{};
-  m.registration = registrationConfigFrom(c, "mapping", m.registration);
-  m.outer_iterations = c.get<int>("mapping.outer_iterations", m.outer_iterations);
-  m.corner_resolution_m = c.get<double>("mapping.corner_resolution_m", m.corner_resolution_m);
-  m.surf_resolution_m = c.get<double>("mapping.surf_resolution_m", m.surf_resolution_m);
-  m.map_voxel_size_m = c.get<double>("mapping.map_voxel_size_m", m.map_voxel_size_m);
-  m.max_points_per_voxel = c.get<int>("mapping.max_points_per_voxel", m.max_points_per_voxel);
-  m.neighbours = c.get<int>("mapping.neighbours", m.neighbours);
-  m.max_neighbour_distance_m = c.get<double>("mapping.max_neighbour_distance_m", m.max_neighbour_distance_m);
-  m.line_eigen_ratio = c.get<double>("mapping.line_eigen_ratio", m.line_eigen_ratio);
-  m.plane_max_point_distance_m = c.get<double>("mapping.plane_max_point_distance_m", m.plane_max_point_distance_m);
-  m.local_map_radius_m = c.get<double>("mapping.local_map_radius_m", m.local_map_radius_m);
-  m.global_map_resolution_m = c.get<double>("mapping.global_map_resolution_m", m.global_map_resolution_m);
-  m.global_map_max_range_m = c.get<double>("mapping.global_map_max_range_m", m.global_map_max_range_m);
-  m.compensate_raw_sweeps = c.get<bool>("mapping.compensate_raw_sweeps", m.compensate_raw_sweeps);
-  return m;
+  const bool aloam = ablationConfigTable().read(c).aloam;
+  return mapperConfigTable().read(c, aloam ? aloamMapperConfig() : MapperConfig{});
 }
 
 ScanToMapMapper::ScanToMapMapper(MapperConfig config)

@@ -4,7 +4,7 @@
 // are held to the odometry prediction. Every sweep is processed; nothing is dropped.
 #pragma once
 
-#include "core/config.hpp"
+#include "core/config_table.hpp"
 #include "core/types.hpp"
 #include "mapping/global_map.hpp"
 #include "mapping/voxel_map.hpp"
@@ -53,8 +53,9 @@ struct MapperConfig {
 MapperConfig aloamMapperConfig();
 
 // Reads "mapping.*" keys with the defaults above; with "ablation.aloam: true" the defaults are
-// aloamMapperConfig()'s (explicit mapping.* keys still override them).
+// aloamMapperConfig()'s (explicit mapping.* keys still override them). Throws ConfigError.
 MapperConfig mapperConfigFrom(const Config& c);
+const ConfigTable<MapperConfig>& mapperConfigTable();
 
 class ScanToMapMapper {
  public:

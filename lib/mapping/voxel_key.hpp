@@ -25,11 +25,17 @@ struct VoxelKeyHash {
   }
 };
 
+// Voxel index of one coordinate, clamped so that the cast cannot overflow (a tiny voxel or a far point; a
+// NaN lands in voxel 0) and a neighbour index (+-1) still fits in 32 bits.
+inline std::int32_t voxelIndex(double coordinate, double voxel_size) {
+  const double i = std::floor(coordinate / voxel_size);
+  constexpr double kLimit = 2147483646.0;
+  return i >= -kLimit && i <= kLimit ? static_cast<std::int32_t>(i) : (i > 0 ? 2147483646 : (i < 0 ? -2147483646 : 0));
+}
+
 template <class Vec>
 inline VoxelKey voxelOf(const Vec& p, double voxel_size) {
-  return {static_cast<std::int32_t>(std::floor(p.x() / voxel_size)),
-          static_cast<std::int32_t>(std::floor(p.y() / voxel_size)),
-          static_cast<std::int32_t>(std::floor(p.z() / voxel_size))};
+  return {voxelIndex(p.x(), voxel_size), voxelIndex(p.y(), voxel_size), voxelIndex(p.z(), voxel_size)};
 }
 
 }  // namespace adit

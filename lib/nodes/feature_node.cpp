@@ -5,6 +5,7 @@
 #include "msg/convert.hpp"
 #include "msg/sweep_codec.hpp"
 #include "nodes/imu_buffer.hpp"
+#include "nodes/node_config.hpp"
 
 #include <deque>
 #include <map>
@@ -24,12 +25,10 @@ class FeatureNode : public runtime::Node {
       : Node("feature"),
         extractor_(featureConfigFrom(config)),
         // IMU older than a sweep plus this margin is of no further use to deskewing.
-        imu_(config.get<double>("features.node.imu_keep_s", 0.5)) {
-    // An odometry pose older than this (s) before a sweep is too stale to predict its motion.
-    max_prior_age_s_ = config.get<double>("features.node.max_prior_age_s", 0.3);
-    // FEATURES carries the sweep only thinned to this voxel (m): what the mapper's global map (0.1 m) and,
-    // thinned again, the loop closer's keyframes need. 0 = the whole preprocessed sweep (5x the bytes).
-    map_cloud_voxel_ = config.get<double>("features.node.map_cloud_voxel", 0.1);
+        imu_(featureNodeConfigTable().read(config).imu_keep_s) {
+    const FeatureNodeConfig node = featureNodeConfigTable().read(config);
+    max_prior_age_s_ = node.max_prior_age_s;
+    map_cloud_voxel_ = node.map_cloud_voxel;
     // LIDAR_POINTS in either form: compact lidar_scan_t or the full-float point_cloud_t of older logs.
     subscribe<msg::SweepMessage>("points", "LIDAR_POINTS", [this](const msg::SweepMessage& m) { onSweep(m); });
     subscribe<adit::imu_t>("imu", "IMU", [this](const adit::imu_t& m) { imu_.add(m); });

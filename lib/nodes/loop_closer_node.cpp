@@ -7,6 +7,7 @@
 #include "map/map_products.hpp"
 #include "map/map_updates.hpp"
 #include "msg/convert.hpp"
+#include "nodes/node_config.hpp"
 #include "nodes/products.hpp"
 #include "nodes/run_state.hpp"
 #include "runtime/record_log.hpp"
@@ -39,9 +40,8 @@ class LoopCloserNode : public runtime::Node, public WritesProducts {
  public:
   explicit LoopCloserNode(const Config& config)
       : Node("loop_closer"), closer_(loopCloserConfigFrom(config)),
-        map_voxel_(config.get<double>("loop.map_voxel", 0.1)),
-        // Keyframes between checkpoints (also written after every loop and on stop). 0 = never.
-        checkpoint_keyframes_(config.get<int>("loop.node.checkpoint_keyframes", 10)),
+        map_voxel_(loopCloserNodeConfigTable().read(config).map_voxel),
+        checkpoint_keyframes_(loopCloserNodeConfigTable().read(config).checkpoint_keyframes),
         updates_(mapUpdateConfigFrom(config)), state_("loop_closer") {
     subscribe<adit::odometry_t>("mapped", "ODOM_MAPPED", [this](const adit::odometry_t& m) { onMapped(m); });
     subscribe<adit::command_t>("command", "MAPPER_COMMAND", [this](const adit::command_t& m) { onCommand(m); },

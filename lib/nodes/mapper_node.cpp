@@ -7,6 +7,7 @@
 #include "features/preprocess.hpp"
 #include "mapping/scan_to_map.hpp"
 #include "msg/convert.hpp"
+#include "nodes/node_config.hpp"
 #include "nodes/products.hpp"
 #include "nodes/run_state.hpp"
 
@@ -22,12 +23,11 @@ class MapperNode : public runtime::Node, public WritesProducts {
  public:
   explicit MapperNode(const Config& config)
       : Node("mapper"), mapper_(mapperConfigFrom(config)),
-        map_voxel_(config.get<double>("mapping.node.map_voxel", 0.1)),
+        map_voxel_(mapperNodeConfigTable().read(config).map_voxel),
         // ODOM_MAPPED carries the sweep for the loop closer's keyframes, which it thins to 0.2 m itself
         // (loop.keyframe_voxel); keep this at or below that. 0 = forward it whole.
-        forward_voxel_(config.get<double>("mapping.node.forward_cloud_voxel", 0.2)),
-        // Sensor seconds between checkpoints of the local map (live runs only). 0 = only on stop.
-        checkpoint_period_us_(toUtime(config.get<double>("mapping.node.checkpoint_period_s", 2.0))),
+        forward_voxel_(mapperNodeConfigTable().read(config).forward_cloud_voxel),
+        checkpoint_period_us_(toUtime(mapperNodeConfigTable().read(config).checkpoint_period_s)),
         state_("mapper") {
     subscribe<adit::odometry_t>("odometry", "ODOM_SCAN", [this](const adit::odometry_t& m) { onOdometry(m); });
     subscribe<adit::pose_graph_t>("graph", "POSE_GRAPH", [this](const adit::pose_graph_t& m) { onGraph(m); },

@@ -4,6 +4,7 @@
 #include "features/preprocess.hpp"
 #include "msg/convert.hpp"
 #include "nodes/imu_buffer.hpp"
+#include "nodes/node_config.hpp"
 #include "nodes/run_state.hpp"
 #include "odometry/initial_guess.hpp"
 #include "odometry/pose_increment.hpp"
@@ -23,17 +24,12 @@ class OdometryNode : public runtime::Node {
       : Node("odometry"),
         odometry_(scanToScanConfigFrom(config)),
         guess_config_(initialGuessConfigFrom(config)),
-        imu_(config.get<double>("odometry.node.imu_keep_s", 1.0)),
+        imu_(odometryNodeConfigTable().read(config).imu_keep_s),
         state_("odometry") {
-    // The sweep forwarded on ODOM_SCAN feeds only the mapper's global map (itself at 0.1 m). FEATURES already
-    // carries it thinned to features.node.map_cloud_voxel (0.1 m): thinning at the same voxel again changes
-    // next to nothing (voxel centroids), a coarser one thins it further. 0 = forward it as received.
-    forward_voxel_ = config.get<double>("odometry.node.forward_cloud_voxel", 0.1);
-    // Sensor seconds between checkpoints of the pose (live runs only; a few hundred bytes each).
-    checkpoint_period_us_ = toUtime(config.get<double>("odometry.node.checkpoint_period_s", 0.5));
-    // After a gap in the input (a restart, a stalled stage) the pose continues at the last velocity for at
-    // most this long (s); beyond, it stays where it was.
-    max_extrapolation_s_ = config.get<double>("odometry.node.max_extrapolation_s", 5.0);
+    const OdometryNodeConfig node = odometryNodeConfigTable().read(config);
+    forward_voxel_ = node.forward_cloud_voxel;
+    checkpoint_period_us_ = toUtime(node.checkpoint_period_s);
+    max_extrapolation_s_ = node.max_extrapolation_s;
     subscribe<adit::features_t>("features", "FEATURES", [this](const adit::features_t& m) { onFeatures(m); });
     subscribe<adit::imu_t>("imu", "IMU", [this](const adit::imu_t& m) { imu_.add(m); });
     advertise("odometry", "ODOM_SCAN");

@@ -3,6 +3,7 @@
 #include "nodes/feature_node.hpp"
 #include "nodes/loop_closer_node.hpp"
 #include "nodes/mapper_node.hpp"
+#include "nodes/node_config.hpp"
 #include "nodes/odometry_node.hpp"
 #include "runtime/process.hpp"
 
@@ -14,6 +15,7 @@ const std::vector<std::string>& pipelineNodeNames() {
 }
 
 std::unique_ptr<runtime::Node> makeNode(const std::string& name, const Config& config) {
+  validatePipelineConfig(config);
   if (name == "feature") return makeFeatureNode(config);
   if (name == "odometry") return makeOdometryNode(config);
   if (name == "mapper") return makeMapperNode(config);
@@ -22,11 +24,9 @@ std::unique_ptr<runtime::Node> makeNode(const std::string& name, const Config& c
 }
 
 std::map<std::string, std::string> pipelineConfigKeys(const Config& config) {
-  std::map<std::string, std::string> reads;
-  config.recordReadsInto(&reads);
-  for (const auto& name : pipelineNodeNames()) makeNode(name, config);
-  config.recordReadsInto(nullptr);
-  return reads;
+  std::map<std::string, std::string> keys;
+  for (const auto& info : pipelineConfigDescription(config)) keys[info.key] = info.value;
+  return keys;
 }
 
 }  // namespace adit::nodes

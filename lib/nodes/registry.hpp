@@ -14,8 +14,8 @@ namespace adit::nodes {
 // Pipeline order: feature -> odometry -> mapper -> loop_closer.
 const std::vector<std::string>& pipelineNodeNames();
 
-// Builds a node from the whole configuration (it reads its own section). Throws std::runtime_error on an
-// unknown name or bad config.
+// Builds a node from the whole configuration (it reads its own section) after validating all of it
+// (validatePipelineConfig). Throws ConfigError on a bad config, std::runtime_error on an unknown name.
 std::unique_ptr<runtime::Node> makeNode(const std::string& name, const Config& config);
 
 // Every configuration key the pipeline's nodes read, with the value they resolve to under `config`

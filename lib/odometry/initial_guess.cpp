@@ -3,19 +3,30 @@
 #include "core/geometry.hpp"
 #include "features/deskew.hpp"
 #include "features/link3d_match.hpp"
+#include "odometry/scan_to_scan.hpp"
 
 #include <cmath>
 
 namespace adit {
 
+const ConfigTable<InitialGuessConfig>& initialGuessConfigTable() {
+  using G = InitialGuessConfig;
+  static const ConfigTable<G> table = [] {
+    ConfigTable<G> t("odometry");
+    t.add("use_link3d_seed", &G::use_link3d, anyValue(), "", "seed from LinK3D matches (false: motion model only, A-LOAM)")
+     .add("use_imu_rotation", &G::use_imu, anyValue(), "", "gyro rotation between sweeps as the seed's rotation when the IMU covers it")
+     .add("max_link3d_deviation_m", &G::max_link3d_deviation_m, above(0), "m", "a LinK3D seed farther from the motion model is a bad match set")
+     .add("max_link3d_deviation_deg", &G::max_link3d_deviation_deg, aboveUpTo(0, 180), "deg", "same for rotation");
+    return t;
+  }();
+  return table;
+}
+
 InitialGuessConfig initialGuessConfigFrom(const Config& c) {
   InitialGuessConfig g;
   // Plain A-LOAM (the ablation baseline) seeds from its motion model only.
-  if (c.get("ablation.aloam", false)) g.use_link3d = g.use_imu = false;
-  g.use_link3d = c.get("odometry.use_link3d_seed", g.use_link3d);
-  g.use_imu = c.get("odometry.use_imu_rotation", g.use_imu);
-  g.max_link3d_deviation_m = c.get("odometry.max_link3d_deviation_m", g.max_link3d_deviation_m);
-  g.max_link3d_deviation_deg = c.get("odometry.max_link3d_deviation_deg", g.max_link3d_deviation_deg);
+  if (ablationConfigTable().read(c).aloam) g.use_link3d = g.use_imu = false;
+  g = initialGuessConfigTable().read(c, g);
   const FeatureConfig features = featureConfigFrom(c);
   g.link3d = features.link3d;
   g.ransac = features.ransac;

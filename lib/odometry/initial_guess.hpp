@@ -24,6 +24,9 @@ struct InitialGuessConfig {
   double max_imu_gap_s = 0.02;
 };
 
+// Keys "odometry.use_link3d_seed", "odometry.use_imu_rotation", "odometry.max_link3d_deviation_*"; the LinK3D,
+// RANSAC and IMU mounting keys are the feature stage's (features.link3d.*, features.ransac.*, features.deskew.*).
+const ConfigTable<InitialGuessConfig>& initialGuessConfigTable();
 InitialGuessConfig initialGuessConfigFrom(const Config& c);
 
 struct InitialGuess {

@@ -91,24 +91,23 @@ void remapDegenerate(Vector6d& xi, const DegeneracyReport& d, const Vector6d& ta
 
 }  // namespace
 
-RegistrationConfig registrationConfigFrom(const Config& c, const std::string& prefix,
-                                          const RegistrationConfig& defaults) {
-  RegistrationConfig r = defaults;
-  const auto key = [&](const char* name) { return prefix + "." + name; };
-  r.max_solver_iterations = c.get<int>(key("max_solver_iterations"), r.max_solver_iterations);
-  r.loss = c.get<std::string>(key("loss"), r.loss);
-  r.loss_scale_m = c.get<double>(key("loss_scale_m"), r.loss_scale_m);
-  r.min_correspondences = c.get<int>(key("min_correspondences"), r.min_correspondences);
-  r.point_sigma_m = c.get<double>(key("point_sigma_m"), r.point_sigma_m);
-  r.degeneracy_ratio_translation = c.get<double>(key("degeneracy_ratio_translation"), r.degeneracy_ratio_translation);
-  r.degeneracy_ratio_rotation = c.get<double>(key("degeneracy_ratio_rotation"), r.degeneracy_ratio_rotation);
-  r.degeneracy_prior = c.get<bool>(key("degeneracy_prior"), r.degeneracy_prior);
-  r.degeneracy_from_planes_only = c.get<bool>(key("degeneracy_from_planes_only"), r.degeneracy_from_planes_only);
-  r.degeneracy_prior_strength = c.get<double>(key("degeneracy_prior_strength"), r.degeneracy_prior_strength);
-  r.degeneracy_remap = c.get<bool>(key("degeneracy_remap"), r.degeneracy_remap);
-  r.prior_sigma_translation_m = c.get<double>(key("prior_sigma_translation_m"), r.prior_sigma_translation_m);
-  r.prior_sigma_rotation_rad = c.get<double>(key("prior_sigma_rotation_rad"), r.prior_sigma_rotation_rad);
-  return r;
+ConfigTable<RegistrationConfig> registrationConfigTable(const std::string& prefix) {
+  using G = RegistrationConfig;
+  ConfigTable<G> t(prefix);
+  t.add("max_solver_iterations", &G::max_solver_iterations, between(1, 1000), "", "Ceres iterations per correspondence round")
+   .add("loss", &G::loss, oneOf({"huber", "cauchy", "none"}), "", "robust loss of the residuals")
+   .add("loss_scale_m", &G::loss_scale_m, above(0), "m", "scale of the robust loss (A-LOAM's Huber: 0.1)")
+   .add("min_correspondences", &G::min_correspondences, between(1, 1000000), "", "fewer and the round fails (pose not trusted)")
+   .add("point_sigma_m", &G::point_sigma_m, above(0), "m", "sigma of a point-to-feature residual (scales the information matrix)")
+   .add("degeneracy_ratio_translation", &G::degeneracy_ratio_translation, between(0, 1), "", "degenerate when an eigenvalue < ratio * largest (translation block)")
+   .add("degeneracy_ratio_rotation", &G::degeneracy_ratio_rotation, between(0, 1), "", "same for the rotation block")
+   .add("degeneracy_prior", &G::degeneracy_prior, anyValue(), "", "hold degenerate directions to the motion model (false: plain A-LOAM)")
+   .add("degeneracy_from_planes_only", &G::degeneracy_from_planes_only, anyValue(), "", "judge degeneracy from point-to-plane information only")
+   .add("degeneracy_prior_strength", &G::degeneracy_prior_strength, above(0), "", "stiffness of that prior relative to the largest eigenvalue")
+   .add("degeneracy_remap", &G::degeneracy_remap, anyValue(), "", "set the solution along degenerate directions to the prior's (Zhang 2016)")
+   .add("prior_sigma_translation_m", &G::prior_sigma_translation_m, above(0), "m", "motion-model uncertainty per sweep (covariance of degenerate directions)")
+   .add("prior_sigma_rotation_rad", &G::prior_sigma_rotation_rad, above(0), "rad", "same for rotation");
+  return t;
 }
 
 RegistrationResult registerStep(const Correspondences& matches, const Eigen::Isometry3d& T0,

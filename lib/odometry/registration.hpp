@@ -4,7 +4,7 @@
 // motion-model prior. The caller recomputes correspondences at the new pose and calls again (outer loop).
 #pragma once
 
-#include "core/config.hpp"
+#include "core/config_table.hpp"
 #include "core/types.hpp"
 #include "odometry/correspondences.hpp"
 #include "odometry/degeneracy.hpp"
@@ -54,9 +54,8 @@ struct RegistrationConfig {
   double prior_sigma_rotation_rad = 0.01;
 };
 
-// Reads keys "<prefix>.max_solver_iterations", "<prefix>.loss", ...; missing keys keep `defaults`.
-RegistrationConfig registrationConfigFrom(const Config& c, const std::string& prefix,
-                                          const RegistrationConfig& defaults = {});
+// Keys "<prefix>.max_solver_iterations", "<prefix>.loss", ... (prefix "odometry" or "mapping").
+ConfigTable<RegistrationConfig> registrationConfigTable(const std::string& prefix);
 
 struct RegistrationResult {
   bool ok = false;  // enough correspondences and a finite solution

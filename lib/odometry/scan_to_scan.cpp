@@ -36,25 +36,42 @@ ScanToScanConfig aloamOdometryConfig() {
   return s;
 }
 
+const ConfigTable<AblationConfig>& ablationConfigTable() {
+  static const ConfigTable<AblationConfig> table = [] {
+    ConfigTable<AblationConfig> t("ablation");
+    t.add("aloam", &AblationConfig::aloam, anyValue(), "", "plain A-LOAM defaults for odometry and mapping (the paper's baseline)");
+    return t;
+  }();
+  return table;
+}
+
+const ConfigTable<ScanToScanConfig>& scanToScanConfigTable() {
+  using S = ScanToScanConfig;
+  static const ConfigTable<S> table = [] {
+    ConfigTable<S> t("odometry");
+    t.nest(&S::registration, registrationConfigTable("odometry"))
+     .add("outer_iterations", &S::outer_iterations, between(1, 100), "", "correspondence rounds per sweep (A-LOAM: 2)")
+     .add("max_match_distance_m", &S::max_match_distance_m, above(0), "m", "largest point-to-neighbour distance accepted when matching")
+     .add("ring_window", &S::ring_window, between(0, 64), "rings", "rings either side searched for the second line / third plane point")
+     .add("plane_neighbours", &S::plane_neighbours, between(3, 100), "points", "nearest previous less-flat points a plane is fitted to")
+     .add("plane_max_point_distance_m", &S::plane_max_point_distance_m, above(0), "m", "a plane is rejected if a point is farther from it")
+     .add("line_min_rings", &S::line_min_rings, between(2, 64), "rings", "collinear points (one per ring) an edge line needs")
+     .add("line_eigen_ratio", &S::line_eigen_ratio, atLeast(1), "", "line if the largest PCA eigenvalue exceeds ratio * the second")
+     .add("line_max_point_distance_m", &S::line_max_point_distance_m, above(0), "m", "a line is rejected if a point is farther from it")
+     .add("three_point_planes", &S::three_point_planes, anyValue(), "", "A-LOAM's unchecked three-point planes (ablation only)")
+     .add("ring_neighbours", &S::ring_neighbours, between(0, 100), "points", "nearest points per ring added to a plane fit")
+     .add("compensate_mixed_deskew", &S::compensate_mixed_deskew, anyValue(), "", "move a raw sweep to its end instant when its neighbour is deskewed")
+     .add("use_link3d_seed", &S::use_link3d_seed, anyValue(), "", "seed from LinK3D matches (false: motion model only, A-LOAM)")
+     .add("max_velocity_gap_s", &S::max_velocity_gap_s, above(0), "s", "longest gap over which the constant-velocity model extrapolates")
+     .add("hold_velocity_time_constant_s", &S::hold_velocity_time_constant_s, atLeast(0), "s", "averaging of the velocity degenerate directions hold to; 0 = last motion");
+    return t;
+  }();
+  return table;
+}
+
 ScanToScanConfig scanToScanConfigFrom(const Config& c) {
-  ScanToScanConfig s = c.get<bool>("ablation.aloam", false) ? aloamOdometryConfig() : ScanToScanConfig{};
-  s.registration = registrationConfigFrom(c, "odometry", s.registration);
-  s.outer_iterations = c.get<int>("odometry.outer_iterations", s.outer_iterations);
-  s.max_match_distance_m = c.get<double>("odometry.max_match_distance_m", s.max_match_distance_m);
-  s.ring_window = c.get<int>("odometry.ring_window", s.ring_window);
-  s.plane_neighbours = c.get<int>("odometry.plane_neighbours", s.plane_neighbours);
-  s.plane_max_point_distance_m = c.get<double>("odometry.plane_max_point_distance_m", s.plane_max_point_distance_m);
-  s.line_min_rings = c.get<int>("odometry.line_min_rings", s.line_min_rings);
-  s.line_eigen_ratio = c.get<double>("odometry.line_eigen_ratio", s.line_eigen_ratio);
-  s.line_max_point_distance_m = c.get<double>("odometry.line_max_point_distance_m", s.line_max_point_distance_m);
-  s.three_point_planes = c.get<bool>("odometry.three_point_planes", s.three_point_planes);
-  s.ring_neighbours = c.get<int>("odometry.ring_neighbours", s.ring_neighbours);
-  s.compensate_mixed_deskew = c.get<bool>("odometry.compensate_mixed_deskew", s.compensate_mixed_deskew);
-  s.use_link3d_seed = c.get<bool>("odometry.use_link3d_seed", s.use_link3d_seed);
-  s.max_velocity_gap_s = c.get<double>("odometry.max_velocity_gap_s", s.max_velocity_gap_s);
-  s.hold_velocity_time_constant_s =
-      c.get<double>("odometry.hold_velocity_time_constant_s", s.hold_velocity_time_constant_s);
-  return s;
+  const bool aloam = ablationConfigTable().read(c).aloam;
+  return scanToScanConfigTable().read(c, aloam ? aloamOdometryConfig() : ScanToScanConfig{});
 }
 
 ScanToScanOdometry::ScanToScanOdometry(ScanToScanConfig config) : config_(std::move(config)) {}

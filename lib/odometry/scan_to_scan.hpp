@@ -4,7 +4,7 @@
 // Jacobian and held to the motion model. Deterministic: the output depends only on the inputs and config.
 #pragma once
 
-#include "core/config.hpp"
+#include "core/config_table.hpp"
 #include "core/types.hpp"
 #include "odometry/feature_fit.hpp"
 #include "odometry/pose_increment.hpp"
@@ -66,9 +66,17 @@ struct ScanToScanConfig {
 // 5 m matching radius, no compensation of raw sweeps.
 ScanToScanConfig aloamOdometryConfig();
 
+// Keys "odometry.*" (the registration's included).
+const ConfigTable<ScanToScanConfig>& scanToScanConfigTable();
 // Reads "odometry.*" keys with the defaults above. If "ablation.aloam" is true the defaults are those of
-// aloamOdometryConfig() (explicit odometry.* keys still override them).
+// aloamOdometryConfig() (explicit odometry.* keys still override them). Throws ConfigError.
 ScanToScanConfig scanToScanConfigFrom(const Config& c);
+
+// The ablation switch "ablation.aloam": plain A-LOAM defaults in odometry and mapping (see aloam.yaml).
+struct AblationConfig {
+  bool aloam = false;
+};
+const ConfigTable<AblationConfig>& ablationConfigTable();
 
 class ScanToScanOdometry {
  public:

@@ -2,6 +2,8 @@
 // processes, open lcm-spy, evaluate trajectories). `adit <command> --help` documents each command.
 #include "commands.hpp"
 
+#include "core/config.hpp"
+
 #include <spdlog/spdlog.h>
 
 #include <cstdio>
@@ -40,6 +42,9 @@ int main(int argc, char** argv) {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     return app.exit(e);
+  } catch (const adit::ConfigError& e) {  // a bad configuration: one line, status 2 (as the processes)
+    spdlog::error("{}", e.what());
+    return 2;
   } catch (const std::exception& e) {
     spdlog::error("{}", e.what());
     return 1;

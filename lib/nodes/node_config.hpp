@@ -1,0 +1,63 @@
+// Node-level keys (`<stage>.node.*`: buffers, what each process forwards and saves) and the pipeline's whole
+// configuration schema: every key the four stages read, which top-level sections belong to the pipeline,
+// and the validation run when a pipeline node is built or `adit config` loads a file.
+//
+// Section ownership. A configuration file may hold keys for several readers; each top-level section has one
+// owner. The pipeline owns `features`, `odometry`, `mapping`, `loop` and `ablation`: every key there must be
+// in a table (an unknown one is an error naming it, its file and the nearest known key). The sections in
+// foreignConfigSections() are read by other code and skipped here: `sim` (lib/sim: adit sim / demo / bench),
+// `lidar_driver` (lib/drivers: adit-lidar-bridge), `pcd` and `imu_csv` (lib/io: importers, bridges), `eval`
+// (lib/eval: adit eval). Any other top-level section is an error. A new reader of the YAML files adds its
+// section to foreignConfigSections().
+#pragma once
+
+#include "core/config_table.hpp"
+
+#include <map>
+#include <string>
+#include <vector>
+
+namespace adit::nodes {
+
+struct FeatureNodeConfig {
+  double imu_keep_s = 0.5;       // IMU older than a sweep plus this margin is of no use to deskewing
+  double max_prior_age_s = 0.3;  // an odometry pose older than this before a sweep is too stale a prior
+  // FEATURES carries the sweep only thinned to this voxel: what the mapper's global map (0.1 m) and, thinned
+  // again, the loop closer's keyframes need. 0 = the whole preprocessed sweep (5x the bytes).
+  double map_cloud_voxel = 0.1;
+};
+struct OdometryNodeConfig {
+  double imu_keep_s = 1.0;
+  double forward_cloud_voxel = 0.1;  // thinning of the sweep forwarded on ODOM_SCAN (0 = as received)
+  double checkpoint_period_s = 0.5;  // sensor seconds between pose checkpoints (live runs; ~200 B each)
+  // After a gap in the input (a restart, a stalled stage) the pose continues at the last velocity for at most
+  // this long; beyond, it stays where it was.
+  double max_extrapolation_s = 5.0;
+};
+struct MapperNodeConfig {
+  double map_voxel = 0.1;
+  double forward_cloud_voxel = 0.2;  // thinning of the sweep forwarded on ODOM_MAPPED (0 = whole)
+  double checkpoint_period_s = 2.0;  // sensor seconds between local-map checkpoints (live runs; 0 = on stop only)
+};
+struct LoopCloserNodeConfig {
+  double map_voxel = 0.1;         // key "loop.map_voxel" (kept where it always was)
+  int checkpoint_keyframes = 10;  // key "loop.node.checkpoint_keyframes": keyframes between checkpoints (0 = never)
+};
+
+const ConfigTable<FeatureNodeConfig>& featureNodeConfigTable();
+const ConfigTable<OdometryNodeConfig>& odometryNodeConfigTable();
+const ConfigTable<MapperNodeConfig>& mapperNodeConfigTable();
+const ConfigTable<LoopCloserNodeConfig>& loopCloserNodeConfigTable();
+
+// Top-level sections read by code other than the pipeline (see above).
+const std::vector<std::string>& foreignConfigSections();
+
+// Every pipeline key (sorted, each once) with the value in force under `config`, its default, type, range,
+// unit and doc. Reads every table: throws ConfigError on a bad value.
+std::vector<ConfigKeyInfo> pipelineConfigDescription(const Config& config);
+
+// Unknown keys (see section ownership) and bad values: throws ConfigError with one line naming the key,
+// the value, the file and what is allowed.
+void validatePipelineConfig(const Config& config);
+
+}  // namespace adit::nodes
