@@ -34,7 +34,10 @@ std::string timestamp() {
 
 void registerLaunchCommand(CLI::App& app) {
   auto args = std::make_shared<LaunchArgs>();
-  auto* cmd = app.add_subcommand("launch", "Start and supervise the processes of a launch file (README: Running the processes). Exit status 0: ended as planned; 1: a process could not be started; 2: a process gave up or failed (the last line says which)");
+  auto* cmd = app.add_subcommand(
+      "launch",
+      "Start and supervise the processes of a launch file (README: Running the processes). Exit status 0: ended as "
+      "planned; 1: a process could not be started; 2: a process gave up or failed (the last line says which)");
   cmd->add_option("launch_file", args->file, "Launch file, e.g. launch/sim.launch.yaml")->required()->check(CLI::ExistingFile);
   cmd->add_option("--set", args->sets, "Set a ${VAR} of the launch file: VAR=VALUE (repeatable)");
   cmd->add_option("--duration", args->duration_s, "Stop after this many seconds (default: Ctrl-C or the file's stop_when_exit)");

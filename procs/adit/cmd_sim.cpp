@@ -60,7 +60,8 @@ void registerSimCommand(CLI::App& app) {
   cmd->add_option("--lcm-url", a->lcm_url, "With --live: LCM provider (default: $LCM_DEFAULT_URL or udpm)");
   cmd->add_flag("--no-ground-truth-channel", a->no_truth_channel, "Do not publish GROUND_TRUTH");
   cmd->add_option("--stall-lidar", a->stall_lidar,
-                  "Fault test: publish no LIDAR_POINTS (nor their GROUND_TRUTH) from START for SECONDS of sensor time (START:SECONDS)");
+                  "Fault test: publish no LIDAR_POINTS (nor their GROUND_TRUTH) from START for SECONDS of sensor "
+                  "time (START:SECONDS)");
   cmd->add_option("--stall-imu", a->stall_imu, "Fault test: publish no IMU from START for SECONDS (START:SECONDS)");
   cmd->callback([a] {
     if (a->live == !a->output.empty()) throw CLI::ValidationError("adit sim", "give either -o LOG or --live");
@@ -72,7 +73,8 @@ void registerSimCommand(CLI::App& app) {
 
     adit::sources::SimChannels channels;
     if (a->no_truth_channel) channels.ground_truth.clear();
-    const adit::sources::SimStalls stalls{parseStall(a->stall_lidar, "--stall-lidar"), parseStall(a->stall_imu, "--stall-imu")};
+    const adit::sources::SimStalls stalls{parseStall(a->stall_lidar, "--stall-lidar"),
+                                          parseStall(a->stall_imu, "--stall-imu")};
     adit::sources::SimSource source(config, channels, stalls);
     fmt::print("sim: world {} ({:.0f} m route), sensor {}, {:.0f} s, seed {}: {} sweeps\n", config.world,
                source.simulator().lapLength(), config.sensor, config.duration_s, config.seed,
