@@ -31,7 +31,7 @@ out=$("${NS[@]}" sh -c 'mount -t tmpfs -o size=64k tmpfs "$1/full" || exit 99
   "$2/adit" import kitti "$1/seq" -o "$1/full/out.lcmlog"; s=$?; ls -A "$1/full" | sed "s/^/left: /"; exit $s' _ "$WORK" "$BIN" 2>&1)
 check "import" $? "$out" "out.lcmlog"
 out=$("${NS[@]}" sh -c 'mount -t tmpfs -o size=64k tmpfs "$1/full" || exit 99
-  "$2/adit" replay "$1/input.lcmlog" -o "$1/full/run" --stages feature --no-progress; s=$?
+  "$2/adit" replay "$1/input.lcmlog" -o "$1/full/run" --stages feature --record-all --no-progress; s=$?
   ls -A "$1/full/run" 2>/dev/null | grep -i lcmlog | sed "s/^/left: /"; exit $s' _ "$WORK" "$BIN" 2>&1)
 check "replay" $? "$out" "output.lcmlog"
 exit $fail
