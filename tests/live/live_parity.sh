@@ -10,7 +10,7 @@ WORK=$(mktemp -d)
 trap 'rm -rf "$WORK"' EXIT
 cd "$WORK"
 "$BIN/adit" sim --world roadway-loop --duration 20 --seed 3 -o sim.lcmlog --gt gt.tum >/dev/null 2>&1
-"$BIN/adit" replay sim.lcmlog -o replay >/dev/null
+"$BIN/adit" replay sim.lcmlog -o replay --record-all >/dev/null
 # The mapper process on replay's ODOM_SCAN and POSE_GRAPH, then the loop closer process on its ODOM_MAPPED.
 "$BIN/adit-mapper" --lcm-url "file://$WORK/replay/output.lcmlog?speed=0" \
   --out-url "file://$WORK/mapper_out.lcmlog?mode=w" --run-dir live 2>&1 | tail -1
