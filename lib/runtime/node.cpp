@@ -2,7 +2,9 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <chrono>
+#include <limits>
 #include <stdexcept>
 
 namespace adit::runtime {
@@ -50,6 +52,7 @@ void Node::deliver(const std::string& channel, const std::uint8_t* data, std::si
 }
 
 void Node::finish(Sink& sink) {
+  for (auto& kv : inputs_) dropHeld(kv.second);  // never confirmed: counted, not delivered
   sink_ = &sink;
   try {
     onFinish();
@@ -59,32 +62,113 @@ void Node::finish(Sink& sink) {
   sink_ = nullptr;
 }
 
-bool Node::admit(Input& input, std::int64_t utime, std::int64_t seq) {
+bool Node::wireOk(const std::string& port, const msg::WireCheck& check, std::size_t size) {
+  if (check.ok() && size <= static_cast<std::size_t>(std::numeric_limits<int>::max())) return true;
+  const bool oversized = !check.ok() ? check.verdict == msg::WireVerdict::Oversized : true;
+  reportError(oversized ? "oversized_count" : "decode_error",
+              (oversized ? "oversized" : "undecodable") + std::string(" message on ") + channels_.at(port) + " (" +
+                  std::to_string(size) + " bytes): " + (check.ok() ? "too large" : check.reason) + ": skipped");
+  return false;
+}
+
+bool Node::valuesOk(const std::string& port, const msg::Validation& invalid) {
+  if (!invalid) return true;
+  reportError(invalid->counter, channels_.at(port) + ": " + invalid->reason + ": skipped");
+  return false;
+}
+
+bool Node::continuesStream(const Input& input, std::int64_t utime) const {
+  const auto tolerance = static_cast<std::int64_t>(checks_.max_future_s * 1e6);
+  if (input.last_utime >= 0 && utime <= input.last_utime) return false;
+  return newest_utime_ < 0 || utime <= newest_utime_ + tolerance;
+}
+
+void Node::dropHeld(Input& input) {
+  for (const Held& h : input.held) {
+    const bool future = h.utime > input.last_utime;
+    reportDrop(future ? "time_future" : "time_backwards",
+               channels_.at(input.port) + ": utime " + std::to_string(h.utime) + (future ? " is too far ahead of " : " is before ") +
+                   std::to_string(future ? newest_utime_ : input.last_utime) + " and the stream did not continue from it: skipped");
+  }
+  input.held.clear();
+}
+
+void Node::admit(Input& input, Held message) {
+  if (input.kind == InputKind::Requests) {
+    accept(input, message);
+    return;
+  }
+  if (input.last_utime >= 0 && message.utime == input.last_utime) {
+    reportDrop("duplicate_time", channels_.at(input.port) + ": utime " + std::to_string(message.utime) +
+                                     " repeats: skipped");
+    return;
+  }
+  if (continuesStream(input, message.utime)) {
+    dropHeld(input);
+    accept(input, message);
+    return;
+  }
+  // Off the stream's time: hold it; a new stream needs confirm_messages consistent successors.
+  const auto tolerance = static_cast<std::int64_t>(checks_.max_future_s * 1e6);
+  const bool chained = !input.held.empty() && message.utime > input.held.back().utime &&
+                       message.utime - input.held.back().utime <= tolerance;
+  if (!chained) dropHeld(input);
+  input.held.push_back(std::move(message));
+  if (static_cast<int>(input.held.size()) <= checks_.confirm_messages) return;
+
+  std::vector<Held> stream = std::move(input.held);
+  input.held.clear();
   const std::string& channel = channels_.at(input.port);
-  // A gap in the publisher's sequence numbers: messages lost on the way (network, full socket buffer).
-  if (input.last_seq >= 0 && seq > input.last_seq + 1) {
-    health_.drops += seq - input.last_seq - 1;
-    count("lost_input", seq - input.last_seq - 1);
-    spdlog::warn("[{}] {}: {} message(s) lost before arriving (seq {} after {})", name_, channel,
-                 seq - input.last_seq - 1, seq, input.last_seq);
+  if (input.last_utime >= 0 && stream.front().utime < input.last_utime) {
+    count("time_resync");
+    spdlog::warn("[{}] {}: time restarted ({} after {}), confirmed by {} messages: following it", name_, channel,
+                 stream.front().utime, input.last_utime, stream.size());
+    input.last_utime = -1;
+    if (input.kind == InputKind::Stream) newest_utime_ = -1;  // other inputs follow it, or re-synchronise too
+    if (input.kind == InputKind::Stream) onTimeJump(input.port);
+  } else {
+    spdlog::warn("[{}] {}: time moved ahead to {}, confirmed by {} messages: following it", name_, channel,
+                 stream.front().utime, stream.size());
   }
-  if (seq >= 0) input.last_seq = seq;
-  if (input.kind == InputKind::Requests) return true;
-  if (input.last_utime >= 0 && utime <= input.last_utime) {
-    reportDrop(utime == input.last_utime ? "duplicate_time" : "time_backwards",
-               channel + ": utime " + std::to_string(utime) + " is not after " + std::to_string(input.last_utime) +
-                   ": skipped");
-    return false;
+  for (Held& h : stream) accept(input, h);
+}
+
+void Node::accept(Input& input, Held& message) {
+  countSequence(input, message.seq);
+  if (input.kind != InputKind::Requests) {
+    const std::int64_t utime = message.utime;
+    if (input.kind == InputKind::Stream && input.last_utime >= 0 && utime - input.last_utime > max_time_gap_us_) {
+      count("time_jump");
+      spdlog::warn("[{}] {}: time jumps forward by {:.3f} s: resetting temporal state", name_,
+                   channels_.at(input.port), static_cast<double>(utime - input.last_utime) * 1e-6);
+      onTimeJump(input.port);
+    }
+    input.last_utime = utime;
+    if (input.kind == InputKind::Stream) newest_utime_ = std::max(newest_utime_, utime);
+    if (utime > health_.last_input_utime) health_.last_input_utime = utime;
   }
-  if (input.kind == InputKind::Stream && input.last_utime >= 0 && utime - input.last_utime > max_time_gap_us_) {
-    count("time_jump");
-    spdlog::warn("[{}] {}: time jumps forward by {:.3f} s: resetting temporal state", name_, channel,
-                 static_cast<double>(utime - input.last_utime) * 1e-6);
-    onTimeJump(input.port);
+  endBursts();
+  message.run();
+}
+
+void Node::countSequence(Input& input, std::int64_t seq) {
+  // Negative or repeated: a publisher that does not number its messages.
+  if (seq < 0 || seq == input.last_seq) return;
+  if (input.last_seq >= 0) {
+    const std::int64_t lost = seq - input.last_seq - 1;
+    const std::string& channel = channels_.at(input.port);
+    if (seq < input.last_seq || lost > checks_.max_seq_gap) {
+      count("seq_reset");
+      spdlog::warn("[{}] {}: sequence restarts (seq {} after {}): not counted as lost", name_, channel, seq,
+                   input.last_seq);
+    } else if (lost > 0) {
+      health_.drops += lost;
+      count("lost_input", lost);
+      spdlog::warn("[{}] {}: {} message(s) lost before arriving (seq {} after {})", name_, channel, lost, seq,
+                   input.last_seq);
+    }
   }
-  input.last_utime = utime;
-  if (utime > health_.last_input_utime) health_.last_input_utime = utime;
-  return true;
+  input.last_seq = seq;
 }
 
 void Node::emit(const std::string& port, Bytes bytes, std::int64_t utime) {
@@ -97,14 +181,24 @@ void Node::reportError(const std::string& counter, const std::string& message) {
   ++health_.errors;
   count(counter);
   health_.last_error = message;
-  spdlog::error("[{}] {}", name_, message);
+  auto [it, first] = bursts_.emplace(counter, 0);
+  if (first) spdlog::error("[{}] {}", name_, message);
+  else ++it->second;
 }
 
 void Node::reportDrop(const std::string& counter, const std::string& message) {
   ++health_.drops;
   count(counter);
   health_.last_error = message;
-  spdlog::warn("[{}] {}", name_, message);
+  auto [it, first] = bursts_.emplace(counter, 0);
+  if (first) spdlog::warn("[{}] {}", name_, message);
+  else ++it->second;
+}
+
+void Node::endBursts() {
+  for (const auto& [counter, repeats] : bursts_)
+    if (repeats > 0) spdlog::warn("[{}] {} more input(s) counted as {} (not logged one by one)", name_, repeats, counter);
+  bursts_.clear();
 }
 
 }  // namespace adit::runtime

@@ -3,11 +3,18 @@
 // process (runtime/process.hpp) and in lockstep with other nodes in `adit replay` (runtime/lockstep.hpp),
 // so there is one code path from message to result.
 //
-// Inputs are checked before the stage sees them: undecodable bytes, wrong message type, and time going
-// backwards on a channel are counted and skipped (with one log line), never thrown.
+// Inputs are checked before the stage sees them, in this order, each failure counted on STATUS and logged
+// once per burst, never thrown:
+//   1. wire layout (msg/wire_check.hpp): counts and string lengths bounded by the bytes present and a sane
+//      maximum, before the generated decoder allocates anything (decode_error / oversized_count);
+//   2. decoding (decode_error);
+//   3. values (msg/validate.hpp): finite, physically possible, unit quaternions, bounded strings (invalid_*);
+//   4. time and sequence (admit()): see InputChecks.
 #pragma once
 
 #include "msg/encode.hpp"
+#include "msg/validate.hpp"
+#include "msg/wire_check.hpp"
 #include "runtime/health.hpp"
 #include "runtime/run_folder.hpp"
 
@@ -27,6 +34,26 @@ enum class InputKind {
   Stream,    // sensor data at a steady rate: time must advance; a forward gap is a time jump
   Events,    // sparse results (loop closures, graphs): time must advance; gaps are normal
   Requests,  // commands: no time checks
+};
+
+// How far an input's time and sequence numbers are trusted. All decisions use message stamps and arrival
+// order only (never the wall clock), so replay stays deterministic.
+struct InputChecks {
+  // A stamp further than this ahead of the newest sensor time the node has accepted (on any Stream input;
+  // an Events input is checked against it only, so sparse results may be minutes apart) is not adopted
+  // at once: the message is held. If the next `confirm_messages` messages continue from it (each later, by
+  // at most this much), the stream really moved (a sensor stalled and resumed): the held messages are
+  // delivered and the gap reported as a time jump. If a message continues the old time instead, the held
+  // ones were forged or corrupt: dropped and counted as time_future. The same confirmation re-synchronises
+  // a stream that goes persistently backwards (a sensor clock restarted): counted as time_resync; an
+  // isolated backwards stamp is dropped as time_backwards.
+  double max_future_s = 2.0;
+  int confirm_messages = 2;
+  // A sequence-number gap larger than this (or a number that goes back) is a restarted or forged publisher,
+  // counted once as seq_reset, not as that many lost messages.
+  std::int64_t max_seq_gap = 10000;
+  msg::WireLimits wire;
+  msg::InputLimits values;
 };
 
 // Where a node's output goes (LCM in a process, the in-process bus in replay).
@@ -69,6 +96,8 @@ class Node {
 
   // Forward gaps in sensor time above this are counted as "time_jump" and reported to onTimeJump().
   void setMaxTimeGap(double seconds) { max_time_gap_us_ = static_cast<std::int64_t>(seconds * 1e6); }
+  void setInputChecks(const InputChecks& checks) { checks_ = checks; }
+  const InputChecks& inputChecks() const { return checks_; }
 
  protected:
   // Declare an input port. Handler is called with the decoded message, in arrival order.
@@ -84,7 +113,8 @@ class Node {
   void count(const std::string& counter, std::int64_t n = 1) { health_.counters[counter] += n; }
   // For counters a stage keeps itself: report its current value.
   void setCount(const std::string& counter, std::int64_t value) { health_.counters[counter] = value; }
-  // Count an input that could not be used (errors) or was skipped (drops), with one log line.
+  // Count an input that could not be used (errors) or was skipped (drops). One log line per burst: repeats of
+  // the same counter are logged as one summary line once an input is accepted again.
   void reportError(const std::string& counter, const std::string& message);
   void reportDrop(const std::string& counter, const std::string& message);
 
@@ -93,16 +123,31 @@ class Node {
   virtual void onFinish() {}
 
  private:
+  // A decoded, valid message waiting for its time to be confirmed.
+  struct Held {
+    std::int64_t utime = 0;
+    std::int64_t seq = -1;
+    std::function<void()> run;
+  };
   struct Input {
     std::string port;
     std::function<void(const std::uint8_t*, std::size_t)> handle;
     InputKind kind = InputKind::Stream;
     std::int64_t last_utime = -1;
     std::int64_t last_seq = -1;
+    std::vector<Held> held;  // messages that do not continue the stream's time, oldest first
   };
-  // Counts sequence gaps; returns false (and counts) if utime goes backwards or repeats on this input.
-  bool admit(Input& input, std::int64_t utime, std::int64_t seq);
+  // Steps 1 and 3 of the input checks; false (counted) when the message must be skipped.
+  bool wireOk(const std::string& port, const msg::WireCheck& check, std::size_t size);
+  bool valuesOk(const std::string& port, const msg::Validation& invalid);
+  // Step 4: runs `run` now, holds it, or drops it (counted); may also run messages held before.
+  void admit(Input& input, Held message);
+  bool continuesStream(const Input& input, std::int64_t utime) const;
+  void dropHeld(Input& input);
+  void accept(Input& input, Held& message);
+  void countSequence(Input& input, std::int64_t seq);
   void emit(const std::string& port, Bytes bytes, std::int64_t utime);
+  void endBursts();
 
   std::string name_;
   std::map<std::string, std::string> channels_;  // port -> channel
@@ -113,6 +158,9 @@ class Node {
   TimingWindow timing_;
   Sink* sink_ = nullptr;  // valid during deliver()/finish()
   std::int64_t max_time_gap_us_ = 1'000'000;
+  InputChecks checks_;
+  std::int64_t newest_utime_ = -1;                 // newest accepted stamp on any Stream input (the sensor clock)
+  std::map<std::string, std::int64_t> bursts_;     // counter -> repeats not logged yet
 };
 
 template <class Msg>
@@ -124,20 +172,21 @@ void Node::subscribe(const std::string& port, const std::string& default_channel
   input.port = port;
   input.kind = kind;
   input.handle = [this, port, handler = std::move(handler)](const std::uint8_t* data, std::size_t size) {
-    Msg msg;
+    if (!wireOk(port, msg::checkWire<Msg>(data, size, checks_.wire), size)) return;
+    auto msg = std::make_shared<Msg>();
     int used = -1;
     try {
-      used = msg.decode(data, 0, static_cast<int>(size));
+      used = msg->decode(data, 0, static_cast<int>(size));
     } catch (const std::exception&) {
-      used = -1;  // absurd array sizes in a corrupt message can make decode allocate and throw
+      used = -1;  // the wire check makes this unreachable; kept so a decoder surprise is still only counted
     }
     if (used < 0) {
       reportError("decode_error", "undecodable message on " + channels_.at(port) + " (" + std::to_string(size) +
                                       " bytes): skipped");
       return;
     }
-    if (!admit(inputs_.at(port), msg.header.utime, msg.header.seq)) return;
-    handler(msg);
+    if (!valuesOk(port, msg::validate(*msg, checks_.values))) return;
+    admit(inputs_.at(port), Held{msg->header.utime, msg->header.seq, [handler, msg] { handler(*msg); }});
   };
   inputs_[port] = std::move(input);
 }

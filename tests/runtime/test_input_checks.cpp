@@ -1,0 +1,139 @@
+// The node's input checks against forged or corrupt messages: oversized counts, impossible values, stamps
+// in the future, clocks that restart, forged sequence numbers. Each is counted and the stream goes on.
+#include "msg/convert.hpp"
+#include "runtime/node.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+using adit::runtime::Bytes;
+
+namespace {
+
+class ImuNode : public adit::runtime::Node {
+ public:
+  ImuNode() : Node("imu-node") {
+    subscribe<adit::imu_t>("imu", "IMU", [this](const adit::imu_t& m) { utimes.push_back(m.header.utime); });
+  }
+  std::vector<std::int64_t> utimes;
+  int jumps = 0;
+
+ protected:
+  void onTimeJump(const std::string&) override { ++jumps; }
+};
+
+class NullSink : public adit::runtime::Sink {
+ public:
+  void publish(const std::string&, const Bytes&, std::int64_t) override {}
+};
+
+adit::imu_t imu(std::int64_t utime, std::int64_t seq = -1) {
+  adit::ImuSample s;
+  s.utime = utime;
+  s.accel = Eigen::Vector3d(0, 0, 9.81);
+  adit::imu_t m = adit::msg::toMessage(s);
+  m.header.seq = seq;
+  return m;
+}
+
+void send(ImuNode& node, const adit::imu_t& m) {
+  NullSink sink;
+  const Bytes b = adit::msg::encode(m);
+  node.deliver("IMU", b.data(), b.size(), sink);
+}
+
+std::int64_t counter(const adit::runtime::Node& n, const std::string& name) {
+  const auto it = n.health().counters.find(name);
+  return it == n.health().counters.end() ? 0 : it->second;
+}
+
+constexpr std::int64_t kMs = 1000, kS = 1'000'000;
+
+}  // namespace
+
+TEST(InputChecks, OneFutureStampIsDroppedAndDoesNotBlockTheStream) {
+  ImuNode node;
+  for (int i = 1; i <= 5; ++i) send(node, imu(i * 5 * kMs));
+  send(node, imu(1000 * kS));  // forged: far ahead
+  for (int i = 6; i <= 10; ++i) send(node, imu(i * 5 * kMs));
+  EXPECT_EQ(node.utimes.size(), 10u);
+  EXPECT_EQ(node.utimes.back(), 50 * kMs);
+  EXPECT_EQ(counter(node, "time_future"), 1);
+  EXPECT_EQ(counter(node, "time_backwards"), 0);
+  EXPECT_EQ(node.jumps, 0);
+}
+
+TEST(InputChecks, ARealStallIsAcceptedAsATimeJumpOnceTheStreamContinues) {
+  ImuNode node;
+  for (int i = 1; i <= 5; ++i) send(node, imu(i * 5 * kMs));
+  for (int i = 0; i < 5; ++i) send(node, imu(10 * kS + i * 5 * kMs));  // the sensor stalled 10 s
+  EXPECT_EQ(node.utimes.size(), 10u);  // nothing lost: the held messages are delivered on confirmation
+  EXPECT_EQ(node.utimes[5], 10 * kS);
+  EXPECT_EQ(counter(node, "time_jump"), 1);
+  EXPECT_EQ(node.jumps, 1);
+  EXPECT_EQ(counter(node, "time_future"), 0);
+}
+
+TEST(InputChecks, AClockThatRestartsIsFollowedAfterConfirmation) {
+  ImuNode node;
+  for (int i = 1; i <= 5; ++i) send(node, imu(100 * kS + i * 5 * kMs));
+  send(node, imu(50 * kS));  // one stale message: dropped
+  for (int i = 6; i <= 7; ++i) send(node, imu(100 * kS + i * 5 * kMs));
+  for (int i = 0; i < 10; ++i) send(node, imu(i * 5 * kMs));  // the sensor rebooted: its clock restarts at 0
+  EXPECT_EQ(counter(node, "time_backwards"), 1);
+  EXPECT_EQ(counter(node, "time_resync"), 1);
+  EXPECT_EQ(node.utimes.size(), 17u);
+  EXPECT_EQ(node.utimes.back(), 45 * kMs);
+  EXPECT_EQ(node.jumps, 1);
+}
+
+TEST(InputChecks, ForgedSequenceNumbersCountAResetNotBillionsLost) {
+  ImuNode node;
+  send(node, imu(1 * kMs, 0));
+  send(node, imu(2 * kMs, 1));
+  send(node, imu(3 * kMs, 4));  // two really lost
+  send(node, imu(4 * kMs, std::numeric_limits<std::int64_t>::max() / 2));  // forged
+  send(node, imu(5 * kMs, 5));
+  send(node, imu(6 * kMs, 6));
+  EXPECT_EQ(counter(node, "lost_input"), 2);
+  EXPECT_EQ(counter(node, "seq_reset"), 2);  // the forged number, and the way back from it
+  EXPECT_EQ(node.utimes.size(), 6u);
+}
+
+TEST(InputChecks, ImpossibleImuValuesAreCountedAndDropped) {
+  ImuNode node;
+  auto m = imu(1 * kMs);
+  m.angular_velocity[2] = 1e30;
+  send(node, m);
+  m = imu(2 * kMs);
+  m.linear_acceleration[0] = std::nan("");
+  send(node, m);
+  m = imu(3 * kMs);
+  m.has_orientation = 1;
+  m.orientation[0] = 2.0;  // not a unit quaternion
+  send(node, m);
+  m = imu(4 * kMs);
+  m.header.frame_id.assign(100000, 'x');
+  send(node, m);
+  send(node, imu(5 * kMs));
+  EXPECT_EQ(counter(node, "invalid_range"), 1);
+  EXPECT_EQ(counter(node, "invalid_nonfinite"), 1);
+  EXPECT_EQ(counter(node, "invalid_quaternion"), 1);
+  EXPECT_EQ(counter(node, "invalid_string"), 1);
+  EXPECT_EQ(node.health().errors, 4);
+  EXPECT_EQ(node.utimes, (std::vector<std::int64_t>{5 * kMs}));
+}
+
+TEST(InputChecks, OversizedCountsAreCountedSeparately) {
+  ImuNode node;
+  Bytes b = adit::msg::encode(imu(1 * kMs));
+  // header.frame_id's length field follows the 8-byte fingerprint and two int64s.
+  b[24] = 0x7f;
+  NullSink sink;
+  node.deliver("IMU", b.data(), b.size(), sink);
+  EXPECT_EQ(counter(node, "oversized_count"), 1);
+  EXPECT_EQ(node.health().errors, 1);
+  EXPECT_TRUE(node.utimes.empty());
+}
