@@ -363,4 +363,12 @@ int SweepMessage::decode(const void* buf, int offset, int maxlen) {
   return used;
 }
 
+Validation validate(const SweepMessage& m, const InputLimits& limits) {
+  if (Validation v = validate(m.header, limits)) return v;
+  const double duration = m.scan.sweep_duration;
+  if (!std::isfinite(duration) || duration < 0 || duration > limits.max_sweep_duration)
+    return Invalid{"invalid_range", "sweep_duration " + std::to_string(duration) + " s is not a sweep's"};
+  return std::nullopt;
+}
+
 }  // namespace adit::msg

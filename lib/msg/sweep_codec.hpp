@@ -3,6 +3,9 @@
 // through decodeSweep() or SweepMessage, which also reads the full-float point_cloud_t of older logs.
 #pragma once
 
+#include "msg/validate.hpp"
+#include "msg/wire_check.hpp"
+
 #include "core/types.hpp"
 #include "msg/firing_table.hpp"
 
@@ -48,5 +51,18 @@ struct SweepMessage {
   // LCM's decode contract: bytes used, or -1 if the bytes are neither type.
   int decode(const void* buf, int offset, int maxlen);
 };
+
+// The node's input checks for LIDAR_POINTS (runtime/node.hpp): the wire layout of whichever sweep type the
+// bytes' fingerprint names, and the values that survive decoding (the header; the sweep's duration). Raw
+// non-finite points are left to preprocessing, which removes and counts them.
+template <>
+inline WireCheck checkWire<SweepMessage>(const std::uint8_t* data, std::size_t size, const WireLimits& limits) {
+  const int full = wire::TypeIndex<adit::point_cloud_t>::value;
+  std::uint64_t hash = 0;
+  for (std::size_t i = 0; i < 8 && i < size; ++i) hash = (hash << 8) | data[i];
+  if (size >= 8 && hash == wireHash(full)) return checkWire(full, data, size, limits);
+  return checkWire<adit::lidar_scan_t>(data, size, limits);
+}
+Validation validate(const SweepMessage& m, const InputLimits& limits);
 
 }  // namespace adit::msg

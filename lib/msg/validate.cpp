@@ -81,6 +81,22 @@ Validation cloud(const adit::point_cloud_t& m, const InputLimits& limits, bool p
   return c.result();
 }
 
+// A compact point set (point_set_t): a positive finite scale, counts that match the arrays, rings and times
+// either absent or one per point, finite times. int16 coordinates cannot be non-finite.
+Validation pointSet(const adit::point_set_t& m, const InputLimits& limits) {
+  const auto n = static_cast<std::size_t>(m.num_points);
+  Check c(limits);
+  c.finite("scale", static_cast<double>(m.scale));
+  c.count("scale", m.scale > 0);
+  c.count("num_points", m.num_points >= 0 && m.x.size() == n && m.y.size() == n && m.z.size() == n);
+  c.count("num_rings", (m.num_rings == 0 || m.num_rings == m.num_points) &&
+                           m.ring.size() == static_cast<std::size_t>(std::max(0, m.num_rings)));
+  c.count("num_times", (m.num_times == 0 || m.num_times == m.num_points) &&
+                           m.dt.size() == static_cast<std::size_t>(std::max(0, m.num_times)));
+  c.finite("dt", m.dt);
+  return c.result();
+}
+
 }  // namespace
 
 Validation validate(const adit::header_t& m, const InputLimits& limits) {
@@ -104,15 +120,19 @@ Validation validate(const adit::point_cloud_t& m, const InputLimits& limits) { r
 
 Validation validate(const adit::features_t& m, const InputLimits& limits) {
   Check c(limits);
-  c.merge(validate(m.header, limits)).merge(cloud(m.cloud, limits, true));
-  for (const adit::point_cloud_t* set : {&m.corner_sharp, &m.corner_less_sharp, &m.surf_flat, &m.surf_less_flat})
-    c.merge(cloud(*set, limits, true));
+  c.merge(validate(m.header, limits)).text("sensor", m.sensor);
+  c.count("num_beams", m.num_beams >= 0);
+  c.finite("sweep_duration", static_cast<double>(m.sweep_duration));
+  if (m.sweep_duration < 0 || m.sweep_duration > limits.max_sweep_duration) c.count("sweep_duration", false);
+  for (const adit::point_set_t* set : {&m.corner_sharp, &m.corner_less_sharp, &m.surf_flat, &m.surf_less_flat, &m.map_cloud})
+    c.merge(pointSet(*set, limits));
   const auto k = static_cast<std::size_t>(m.num_keypoints);
   bool rows = m.num_keypoints >= 0 && m.descriptor_size >= 0 && m.keypoints.size() == k && m.descriptors.size() == k;
   for (std::size_t i = 0; rows && i < k; ++i)
     rows = m.keypoints[i].size() == 3 && m.descriptors[i].size() == static_cast<std::size_t>(m.descriptor_size);
   c.count("num_keypoints", rows);
-  for (std::size_t i = 0; rows && i < k; ++i) c.finite("keypoints", m.keypoints[i]).finite("descriptors", m.descriptors[i]);
+  c.finite("descriptor_scale", static_cast<double>(m.descriptor_scale));
+  for (std::size_t i = 0; rows && i < k; ++i) c.finite("keypoints", m.keypoints[i]);
   return c.result();
 }
 
@@ -125,7 +145,8 @@ Validation validate(const adit::odometry_t& m, const InputLimits& limits) {
   c.position("loop_correction_position", m.loop_correction_position)
       .quaternion("loop_correction_orientation", m.loop_correction_orientation)
       .finite("final_cost", m.final_cost);
-  return c.merge(validate(m.features, limits)).result();
+  for (const adit::point_set_t* set : {&m.corners, &m.surfaces, &m.cloud}) c.merge(pointSet(*set, limits));
+  return c.result();
 }
 
 Validation validate(const adit::loop_closure_t& m, const InputLimits& limits) {

@@ -12,6 +12,7 @@
 #include <adit/loop_closure_t.hpp>
 #include <adit/odometry_t.hpp>
 #include <adit/point_cloud_t.hpp>
+#include <adit/point_set_t.hpp>
 #include <adit/pose_graph_t.hpp>
 #include <adit/status_t.hpp>
 

@@ -185,7 +185,8 @@ void Node::subscribe(const std::string& port, const std::string& default_channel
                                       " bytes): skipped");
       return;
     }
-    if (!valuesOk(port, msg::validate(*msg, checks_.values))) return;
+    using msg::validate;  // unqualified: wrapper types (msg::SweepMessage) bring their own overload by ADL
+    if (!valuesOk(port, validate(*msg, checks_.values))) return;
     admit(inputs_.at(port), Held{msg->header.utime, msg->header.seq, [handler, msg] { handler(*msg); }});
   };
   inputs_[port] = std::move(input);
