@@ -122,7 +122,7 @@ class Walker {
     const auto n = static_cast<std::size_t>(elements);
     if (width > 0 || m.kind == Kind::String) {
       // Strings take at least their 4-byte length each.
-      const std::size_t need = n * std::max<std::size_t>(width, 4);
+      const std::size_t need = n * (m.kind == Kind::String ? std::size_t{4} : width);
       if (need > left()) {
         fail(WireVerdict::Oversized, std::string("count ") + std::to_string(elements) + " for " + m.name + " needs " +
                                          std::to_string(need) + " bytes, " + std::to_string(left()) + " left");

@@ -2,6 +2,8 @@
 // decoder's, valid messages pass, and counts the bytes cannot hold are refused before any allocation.
 #include "msg/wire_check.hpp"
 
+#include <adit/point_cloud_t.hpp>
+
 #include <gtest/gtest.h>
 
 #include <cstring>
@@ -112,4 +114,16 @@ TEST(WireCheck, ElementLimitIsConfigurable) {
   adit::msg::WireLimits tight;
   tight.max_elements = 99;
   EXPECT_EQ(checkWire<adit::point_cloud_t>(b.data(), b.size(), tight).verdict, WireVerdict::Oversized);
+}
+
+// A full message passes: every element width is its type's (an int16 array of n elements takes 2n bytes, not
+// 4n; the first version demanded 4 bytes an element and refused every real sweep).
+TEST(WireCheck, FullMessagesWithNarrowArraysPass) {
+  adit::point_cloud_t m{};
+  m.num_points = 1000;
+  for (auto* v : {&m.x, &m.y, &m.z, &m.intensity, &m.dt}) v->assign(1000, 1.0f);
+  m.ring.assign(1000, 3);
+  const auto b = bytesOf(m);
+  const auto check = checkWire<adit::point_cloud_t>(b.data(), b.size());
+  EXPECT_TRUE(check.ok()) << check.reason;
 }
