@@ -2,7 +2,7 @@
 // decoder's, valid messages pass, and counts the bytes cannot hold are refused before any allocation.
 #include "msg/wire_check.hpp"
 
-#include <adit/point_cloud_t.hpp>
+#include <adit/point_set_t.hpp>
 
 #include <gtest/gtest.h>
 
@@ -119,11 +119,11 @@ TEST(WireCheck, ElementLimitIsConfigurable) {
 // A full message passes: every element width is its type's (an int16 array of n elements takes 2n bytes, not
 // 4n; the first version demanded 4 bytes an element and refused every real sweep).
 TEST(WireCheck, FullMessagesWithNarrowArraysPass) {
-  adit::point_cloud_t m{};
+  adit::point_set_t m{};
+  m.scale = 0.001f;
   m.num_points = 1000;
-  for (auto* v : {&m.x, &m.y, &m.z, &m.intensity, &m.dt}) v->assign(1000, 1.0f);
-  m.ring.assign(1000, 3);
+  for (auto* v : {&m.x, &m.y, &m.z}) v->assign(1000, 7);
   const auto b = bytesOf(m);
-  const auto check = checkWire<adit::point_cloud_t>(b.data(), b.size());
+  const auto check = checkWire<adit::point_set_t>(b.data(), b.size());
   EXPECT_TRUE(check.ok()) << check.reason;
 }
