@@ -2,37 +2,19 @@
 // publishes), for tests of live behaviour without LCM.
 #pragma once
 
+#include "../io/temp_dir.hpp"
 #include "msg/encode.hpp"
 #include "runtime/node.hpp"
 
-#include <cstdlib>
 #include <filesystem>
 #include <map>
-#include <stdexcept>
 #include <string>
 #include <vector>
 
 namespace adit::test {
 
-class TempFolder {
- public:
-  TempFolder() {
-    std::string pattern = (std::filesystem::temp_directory_path() / "adit_live_test_XXXXXX").string();
-    if (!::mkdtemp(pattern.data())) throw std::runtime_error("mkdtemp failed");
-    path_ = pattern;
-  }
-  ~TempFolder() {
-    std::error_code ec;
-    std::filesystem::remove_all(path_, ec);
-  }
-  TempFolder(const TempFolder&) = delete;
-  TempFolder& operator=(const TempFolder&) = delete;
-  const std::string& path() const { return path_; }
-  std::string file(const std::string& name) const { return path_ + "/" + name; }
-
- private:
-  std::string path_;
-};
+// A fresh folder under the system temp dir, removed at scope exit (the io tests' helper).
+using TempFolder = io::test::TempDir;
 
 struct Collector : runtime::Sink {
   void publish(const std::string& channel, const runtime::Bytes& data, std::int64_t) override {

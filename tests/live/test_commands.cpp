@@ -21,6 +21,18 @@ adit::command_t command(const std::string& name, const std::string& argument) {
   return c;
 }
 
+// A loop closer (the map owner, which receives MAPPER_COMMAND) writing into `run`, a folder of its own.
+struct MapOwnerInRunFolder {
+  adit::test::TempFolder parent;
+  std::string run = parent.file("run");
+  std::unique_ptr<adit::runtime::Node> node = adit::nodes::makeNode("loop_closer", adit::Config{});
+  adit::test::Collector sink;
+  MapOwnerInRunFolder() {
+    fs::create_directory(run);
+    node->useRunFolder(adit::test::liveFolder(run));
+  }
+};
+
 std::size_t filesIn(const std::string& dir) {
   std::size_t n = 0;
   for (const auto& e : fs::recursive_directory_iterator(dir)) n += e.is_regular_file() ? 1 : 0;
@@ -28,12 +40,8 @@ std::size_t filesIn(const std::string& dir) {
 }
 
 TEST(Commands, SaveMapWritesTheThreeProductsIntoTheRunFolder) {
-  adit::test::TempFolder parent;
-  const std::string run = parent.file("run");
-  fs::create_directory(run);
-  auto node = adit::nodes::makeNode("loop_closer", adit::Config{});
-  node->useRunFolder(adit::test::liveFolder(run));
-  adit::test::Collector sink;
+  MapOwnerInRunFolder owner;
+  auto& [parent, run, node, sink] = owner;
   for (int k = 0; k < 5; ++k) adit::test::deliver(*node, "ODOM_MAPPED", adit::test::mappedMessage(k), sink);
   adit::test::deliver(*node, "MAPPER_COMMAND", command("save_map", ""), sink);
   adit::test::deliver(*node, "MAPPER_COMMAND", command("save_map", "before_loop.pcd"), sink);
@@ -45,12 +53,8 @@ TEST(Commands, SaveMapWritesTheThreeProductsIntoTheRunFolder) {
 }
 
 TEST(Commands, HostilePathsAreRefusedAndCounted) {
-  adit::test::TempFolder parent;
-  const std::string run = parent.file("run");
-  fs::create_directory(run);
-  auto node = adit::nodes::makeNode("loop_closer", adit::Config{});
-  node->useRunFolder(adit::test::liveFolder(run));
-  adit::test::Collector sink;
+  MapOwnerInRunFolder owner;
+  auto& [parent, run, node, sink] = owner;
   adit::test::deliver(*node, "ODOM_MAPPED", adit::test::mappedMessage(0), sink);
   const std::vector<std::string> hostile{
       parent.file("evil.pcd"), "../evil.pcd", "../../etc/passwd", "sub/map.pcd", "..", ".", ".hidden", "-rf",
