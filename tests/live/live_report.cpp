@@ -2,6 +2,7 @@
 // check in a recording.
 //   restart <process> first_output_after_s=<uptime at its first STATUS with outputs> <recovered counters>
 //   map_update messages=<n> bytes=<n> span_s=<s> kB_per_s=<rate>
+//   counters <process> <name>=<value> ...   (each process's last STATUS: what it counted over the run)
 // With --tum, the odometry_t poses on CHANNEL are written as TUM (e.g. ODOM_MAPPED, for adit eval); with
 // --sensors, the LIDAR_POINTS, IMU and GROUND_TRUTH events are copied to a log `adit replay` can run.
 #include "eval/trajectory_io.hpp"
@@ -39,6 +40,7 @@ int main(int argc, char** argv) {
   if (!sensors_path.empty()) sensors = std::make_unique<adit::runtime::LogWriter>(sensors_path);
   adit::Trajectory poses;
   std::set<std::string> reported;
+  std::map<std::string, adit::status_t> last_status;
   std::int64_t update_bytes = 0, updates = 0, first_update = -1, last_update = -1;
   adit::runtime::LogReader log(argv[1]);
   adit::runtime::LogEvent e;
@@ -49,7 +51,9 @@ int main(int argc, char** argv) {
       sensors->write(e.channel, e.data.data(), e.data.size(), e.timestamp);
     if (e.channel.rfind("STATUS_", 0) == 0) {
       adit::status_t s;
-      if (s.decode(data, 0, size) < 0 || reported.count(s.process) || s.outputs == 0) continue;
+      if (s.decode(data, 0, size) < 0) continue;
+      last_status[s.process] = s;
+      if (reported.count(s.process) || s.outputs == 0) continue;
       std::map<std::string, std::int64_t> counters;
       for (int i = 0; i < s.num_counters; ++i) counters[s.counter_names[i]] = s.counter_values[i];
       if (!counters.count("restarted")) continue;
@@ -74,6 +78,12 @@ int main(int argc, char** argv) {
   const double span = last_update > first_update ? (last_update - first_update) * 1e-6 : 0.0;
   std::printf("map_update messages=%lld bytes=%lld span_s=%.1f kB_per_s=%.1f\n", static_cast<long long>(updates),
               static_cast<long long>(update_bytes), span, span > 0 ? update_bytes / span / 1000.0 : 0.0);
+  for (const auto& [process, s] : last_status) {
+    std::printf("counters %s", process.c_str());
+    for (int i = 0; i < s.num_counters; ++i)
+      std::printf(" %s=%lld", s.counter_names[i].c_str(), static_cast<long long>(s.counter_values[i]));
+    std::printf("\n");
+  }
   if (!tum_channel.empty()) adit::eval::writeTum(tum_path, poses);
   if (sensors) sensors->close();
   return 0;
