@@ -13,6 +13,7 @@ void registerReplayCommand(CLI::App& app);
 void registerLaunchCommand(CLI::App& app);
 void registerSpyCommand(CLI::App& app);
 void registerEvalCommand(CLI::App& app);
+void registerCommandCommand(CLI::App& app);
 
 void registerDemoCommand(CLI::App& app);
 void registerBenchCommand(CLI::App& app);

@@ -38,6 +38,7 @@ int main(int argc, char** argv) {
   registerLaunchCommand(app);
   registerSpyCommand(app);
   registerEvalCommand(app);
+  registerCommandCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
