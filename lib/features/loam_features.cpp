@@ -1,6 +1,6 @@
 #include "features/loam_features.hpp"
 
-#include "features/preprocess.hpp"
+#include "features/voxel_centroids.hpp"
 
 #include <algorithm>
 #include <cstring>
@@ -41,6 +41,8 @@ struct RingSelection {
   int b, e;                        // ring span
   std::vector<std::uint8_t>& taken;  // picked or suppressed
   std::vector<std::uint8_t>& label;
+  std::vector<std::uint64_t>& edges;  // sort keys of one sector's candidates (reused: no allocation per sector)
+  std::vector<std::uint64_t>& flats;
 
   // Suppress neighbours of i on the same surface (stop at a gap larger than suppression_gap).
   void suppress(int i) const {
@@ -67,7 +69,8 @@ struct RingSelection {
   void sector(int sp, int ep, LoamFeatures& out) const {
     // Sort keys: smoothness bits (non-negative floats order like their bit patterns) above the index, so
     // a plain integer sort orders by smoothness with ties by index: fast and deterministic.
-    std::vector<std::uint64_t> edges, flats;
+    edges.clear();
+    flats.clear();
     for (int i = sp; i < ep; ++i) {
       std::uint32_t bits;
       std::memcpy(&bits, &s.smoothness[i], sizeof bits);
@@ -104,20 +107,25 @@ struct RingSelection {
 LoamFeatures selectLoamFeatures(const RingCloud& c, const PointScores& s, const LoamConfig& cfg) {
   LoamFeatures out;
   std::vector<std::uint8_t> taken(c.points.size(), 0), label(c.points.size(), kNone);
-  std::vector<LidarPoint> less_flat;
-  less_flat.reserve(c.points.size());
+  std::vector<std::uint64_t> edges, flats;
+  // Less flat points go straight into the voxel grid (no copy of them all first); a leaf <= 0 keeps them all.
+  const bool downsample = cfg.less_flat_voxel > 0.0f;
+  VoxelCentroids grid(downsample ? cfg.less_flat_voxel : 1.0f, c.points.size() / 4);
   const int sectors = std::max(1, cfg.sectors);
   for (int r = 0; r < c.numRings(); ++r) {
     const int b = c.ring_begin[r], e = c.ring_begin[r + 1];
     const int sp0 = b + cfg.half_window, ep0 = e - cfg.half_window;  // span with complete windows
     if (ep0 <= sp0) continue;
-    RingSelection sel{c, s, cfg, b, e, taken, label};
+    RingSelection sel{c, s, cfg, b, e, taken, label, edges, flats};
     for (int k = 0; k < sectors; ++k)
       sel.sector(sp0 + (ep0 - sp0) * k / sectors, sp0 + (ep0 - sp0) * (k + 1) / sectors, out);
     for (int i = sp0; i < ep0; ++i)
-      if (s.usable[i] && label[i] != kEdge && !sel.isEdge(i)) less_flat.push_back(c.points[i]);
+      if (s.usable[i] && label[i] != kEdge && !sel.isEdge(i)) {
+        if (downsample) grid.add(c.points[i]);
+        else out.less_flat.push_back(c.points[i]);
+      }
   }
-  out.less_flat = voxelDownsample(less_flat, cfg.less_flat_voxel);
+  if (downsample) out.less_flat = grid.take();
   return out;
 }
 
