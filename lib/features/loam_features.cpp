@@ -11,27 +11,31 @@ namespace {
 
 enum Label : std::uint8_t { kNone = 0, kEdge = 1, kFlat = 2 };
 
-// Sorted access to unique keys without sorting them all: only the first `prefix` are ordered up front
-// (the picks rarely need more: each pick suppresses at most 2 half_window neighbours); the rest is sorted
-// the first time it is reached. Same order as a full sort.
+// Sorted access to unique keys without sorting them all: only the first `prefix` are ordered up front (the
+// picks rarely need more: each pick suppresses at most 2 half_window neighbours); each time the ordered part
+// runs out, the next block, twice as long, is selected and sorted. Same order as a full sort.
 template <class Compare>
 class SortedPrefix {
  public:
-  SortedPrefix(std::vector<std::uint64_t>& keys, std::size_t prefix) : keys_(keys), sorted_(std::min(prefix, keys.size())) {
-    if (sorted_ < keys_.size()) std::nth_element(keys_.begin(), keys_.begin() + sorted_, keys_.end(), Compare{});
-    std::sort(keys_.begin(), keys_.begin() + sorted_, Compare{});
+  SortedPrefix(std::vector<std::uint64_t>& keys, std::size_t prefix) : keys_(keys), block_(std::max<std::size_t>(prefix, 1)) {
+    orderUpTo(block_);
   }
   std::uint64_t at(std::size_t k) {
-    if (k >= sorted_) {
-      std::sort(keys_.begin() + sorted_, keys_.end(), Compare{});
-      sorted_ = keys_.size();
-    }
+    while (k >= sorted_) orderUpTo(sorted_ + (block_ *= 2));
     return keys_[k];
   }
 
  private:
+  void orderUpTo(std::size_t end) {
+    end = std::min(end, keys_.size());
+    if (end < keys_.size()) std::nth_element(keys_.begin() + sorted_, keys_.begin() + end, keys_.end(), Compare{});
+    std::sort(keys_.begin() + sorted_, keys_.begin() + end, Compare{});
+    sorted_ = end;
+  }
+
   std::vector<std::uint64_t>& keys_;
-  std::size_t sorted_;
+  std::size_t block_;
+  std::size_t sorted_ = 0;
 };
 
 struct RingSelection {
@@ -78,8 +82,8 @@ struct RingSelection {
       if (isEdge(i)) edges.push_back(key);
       else if (isFlat(i)) flats.push_back(key);
     }
-    SortedPrefix<std::greater<>> edge_order(edges, static_cast<std::size_t>(cfg.max_less_sharp) * (2 * cfg.half_window + 1));
-    SortedPrefix<std::less<>> flat_order(flats, static_cast<std::size_t>(cfg.max_flat) * (2 * cfg.half_window + 1) + 64);
+    SortedPrefix<std::greater<>> edge_order(edges, static_cast<std::size_t>(cfg.max_less_sharp) * 2);
+    SortedPrefix<std::less<>> flat_order(flats, static_cast<std::size_t>(cfg.max_flat) * 4);
     int picked = 0;
     for (std::size_t k = 0; k < edges.size() && picked < cfg.max_less_sharp; ++k) {
       const int i = static_cast<int>(edge_order.at(k) & 0xFFFFFFFFu);

@@ -30,12 +30,24 @@ void VoxelCentroids::grow() {
   }
 }
 
+namespace {
+
+// floor(v) as an integer, for |v| <= 1e15 (exact: such floats convert to int64 without overflow).
+std::int64_t floorToInt(float v) {
+  const auto t = static_cast<std::int64_t>(v);  // truncation toward zero
+  return static_cast<float>(t) > v ? t - 1 : t;
+}
+
+}  // namespace
+
 void VoxelCentroids::add(const LidarPoint& p) {
-  const Eigen::Array3f q = (p.p.array() * inv_leaf_).floor();
-  if (!q.allFinite() || (q.abs() > 1e15f).any()) return;
-  const std::uint64_t key = ((static_cast<std::uint64_t>(static_cast<std::int64_t>(q.x())) & 0x1FFFFF) << 42) |
-                            ((static_cast<std::uint64_t>(static_cast<std::int64_t>(q.y())) & 0x1FFFFF) << 21) |
-                            (static_cast<std::uint64_t>(static_cast<std::int64_t>(q.z())) & 0x1FFFFF);
+  const float x = p.p.x() * inv_leaf_, y = p.p.y() * inv_leaf_, z = p.p.z() * inv_leaf_;
+  // Written so that NaN fails too. A float beyond 2^23 is an integer, so |v| <= 1e15 is |floor(v)| <= 1e15.
+  constexpr float kLimit = 1e15f;
+  if (!(std::fabs(x) <= kLimit && std::fabs(y) <= kLimit && std::fabs(z) <= kLimit)) return;
+  const std::uint64_t key = ((static_cast<std::uint64_t>(floorToInt(x)) & 0x1FFFFF) << 42) |
+                            ((static_cast<std::uint64_t>(floorToInt(y)) & 0x1FFFFF) << 21) |
+                            (static_cast<std::uint64_t>(floorToInt(z)) & 0x1FFFFF);
   if (last_voxel_ < 0 || key != last_key_) {
     const std::size_t mask = table_.size() - 1;
     std::size_t h = bucket(key);
