@@ -114,7 +114,7 @@ LoamFeatures selectLoamFeatures(const RingCloud& c, const PointScores& s, const 
   std::vector<std::uint64_t> edges, flats;
   // Less flat points go straight into the voxel grid (no copy of them all first); a leaf <= 0 keeps them all.
   const bool downsample = cfg.less_flat_voxel > 0.0f;
-  VoxelCentroids grid(downsample ? cfg.less_flat_voxel : 1.0f, c.points.size() / 4);
+  VoxelCentroids grid(downsample ? cfg.less_flat_voxel : 1.0f, c.points.size());
   const int sectors = std::max(1, cfg.sectors);
   for (int r = 0; r < c.numRings(); ++r) {
     const int b = c.ring_begin[r], e = c.ring_begin[r + 1];

@@ -34,10 +34,13 @@ void scoreRing(const RingCloud& c, int b, int e, const LoamConfig& cfg, RingPref
   std::vector<Eigen::Vector3d>& P = prefix.P;
   std::vector<double>& C = prefix.C;
   std::vector<double>& CC = prefix.CC;
-  gaps.assign(n, 0);
+  gaps.resize(n);  // every element below is written before it is read: no zero fill
   P.resize(n + 1);
-  C.assign(n, 0.0);
-  CC.assign(n + 1, 0.0);
+  C.resize(n);
+  CC.resize(n + 1);
+  gaps[0] = 0;
+  C[0] = 0.0;
+  CC[0] = 0.0;
   P[0].setZero();
   for (int k = 0; k < n; ++k) {
     const Eigen::Vector3f& p = c.points[b + k].p;

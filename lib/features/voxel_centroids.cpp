@@ -30,43 +30,23 @@ void VoxelCentroids::grow() {
   }
 }
 
-namespace {
-
-// floor(v) as an integer, for |v| <= 1e15 (exact: such floats convert to int64 without overflow).
-std::int64_t floorToInt(float v) {
-  const auto t = static_cast<std::int64_t>(v);  // truncation toward zero
-  return static_cast<float>(t) > v ? t - 1 : t;
-}
-
-}  // namespace
-
-void VoxelCentroids::add(const LidarPoint& p) {
-  const float x = p.p.x() * inv_leaf_, y = p.p.y() * inv_leaf_, z = p.p.z() * inv_leaf_;
-  // Written so that NaN fails too. A float beyond 2^23 is an integer, so |v| <= 1e15 is |floor(v)| <= 1e15.
-  constexpr float kLimit = 1e15f;
-  if (!(std::fabs(x) <= kLimit && std::fabs(y) <= kLimit && std::fabs(z) <= kLimit)) return;
-  const std::uint64_t key = ((static_cast<std::uint64_t>(floorToInt(x)) & 0x1FFFFF) << 42) |
-                            ((static_cast<std::uint64_t>(floorToInt(y)) & 0x1FFFFF) << 21) |
-                            (static_cast<std::uint64_t>(floorToInt(z)) & 0x1FFFFF);
-  if (last_voxel_ < 0 || key != last_key_) {
-    const std::size_t mask = table_.size() - 1;
-    std::size_t h = bucket(key);
-    while (table_[h] >= 0 && keys_[table_[h]] != key) h = (h + 1) & mask;
-    if (table_[h] < 0) {
-      table_[h] = static_cast<std::int32_t>(keys_.size());
-      keys_.push_back(key);
-      out_.push_back(p);
-      counts_.push_back(1);
-      if (2 * keys_.size() > table_.size()) grow();
-      last_key_ = key;
-      last_voxel_ = static_cast<std::int32_t>(keys_.size()) - 1;
-      return;
-    }
-    last_key_ = key;
+void VoxelCentroids::addToOtherVoxel(std::uint64_t key, const LidarPoint& p) {
+  const std::size_t mask = table_.size() - 1;
+  std::size_t h = bucket(key);
+  while (table_[h] >= 0 && keys_[static_cast<std::size_t>(table_[h])] != key) h = (h + 1) & mask;
+  last_key_ = key;
+  if (table_[h] >= 0) {
     last_voxel_ = table_[h];
+    out_[static_cast<std::size_t>(last_voxel_)].p += p.p;
+    ++counts_[static_cast<std::size_t>(last_voxel_)];
+    return;
   }
-  out_[last_voxel_].p += p.p;
-  ++counts_[last_voxel_];
+  last_voxel_ = static_cast<std::int32_t>(keys_.size());
+  table_[h] = last_voxel_;
+  keys_.push_back(key);
+  out_.push_back(p);
+  counts_.push_back(1);
+  if (2 * keys_.size() > table_.size()) grow();
 }
 
 std::vector<LidarPoint> VoxelCentroids::take() {
