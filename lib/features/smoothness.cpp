@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 
 namespace adit::features {
 namespace {
@@ -73,11 +75,40 @@ void collectSecondDifferences(const RingCloud& c, int b, int e, float max_step, 
   }
 }
 
-float medianNoise(std::vector<float>& second) {
+// The k-th smallest of non-negative floats (what std::nth_element would put at k), by radix selection on
+// their bit patterns, which order like the values: per 11-bit digit, from the top, count, find the digit
+// holding rank k, keep only those values. No data-dependent branches (nth_element's partitioning of noise
+// mispredicts half of them).
+float kthSmallestNonNegative(const std::vector<float>& values, std::size_t k) {
+  std::vector<std::uint32_t> bits, keep;  // the candidates (all values, until the first digit is known)
+  const auto bitsOf = [](float v) {
+    std::uint32_t b;
+    std::memcpy(&b, &v, sizeof b);
+    return b;
+  };
+  const std::size_t n = values.size();
+  for (const int shift : {21, 10, 0}) {  // digits of bits 31..21, 20..10, 10..0
+    const bool first = shift == 21;
+    const std::size_t m = first ? n : bits.size();
+    const auto at = [&](std::size_t i) { return first ? bitsOf(values[i]) : bits[i]; };
+    std::size_t counts[2048] = {};
+    for (std::size_t i = 0; i < m; ++i) ++counts[(at(i) >> shift) & 0x7FF];
+    std::size_t digit = 0;
+    while (k >= counts[digit]) k -= counts[digit++];
+    keep.clear();
+    for (std::size_t i = 0; i < m; ++i)
+      if (((at(i) >> shift) & 0x7FF) == digit) keep.push_back(at(i));
+    bits.swap(keep);
+  }
+  float v;
+  std::memcpy(&v, &bits.front(), sizeof v);
+  return v;
+}
+
+float medianNoise(const std::vector<float>& second) {
   if (second.size() < 100) return 0.0f;
-  const auto mid = second.begin() + static_cast<long>(second.size() / 2);
-  std::nth_element(second.begin(), mid, second.end());
-  return *mid / 1.652f;  // median of |N(0, 6 sigma^2)| = 0.6745 sqrt(6) sigma
+  // median of |N(0, 6 sigma^2)| = 0.6745 sqrt(6) sigma
+  return kthSmallestNonNegative(second, second.size() / 2) / 1.652f;
 }
 
 // Marks the far side of depth jumps and beam-parallel points as unusable.
