@@ -33,6 +33,20 @@ struct GyroIntegrator {
   }
 };
 
+// ((1 - f) R0 + f R1) p + (1 - f) t0 + f t1, written out: the same operations in the same order as Eigen's
+// expression (a row times p sums as a0 + (a1 + a2)), so the result is bit-identical, without Eigen building
+// the blended 3x3 matrix in a temporary for every point.
+Eigen::Vector3f blendedPose(const Eigen::Matrix3f& R0, const Eigen::Matrix3f& R1, const Eigen::Vector3f& t0,
+                            const Eigen::Vector3f& t1, float f, const Eigen::Vector3f& p) {
+  const float g = 1.0f - f;
+  Eigen::Vector3f out;
+  for (int i = 0; i < 3; ++i) {
+    const float m0 = g * R0(i, 0) + f * R1(i, 0), m1 = g * R0(i, 1) + f * R1(i, 1), m2 = g * R0(i, 2) + f * R1(i, 2);
+    out[i] = (m0 * p[0] + (m1 * p[1] + m2 * p[2]) + g * t0[i]) + f * t1[i];
+  }
+  return out;
+}
+
 bool priorUsable(const MotionPrior& m, const DeskewConfig& cfg) {
   return m.valid && m.dt_s > 1e-3 && m.dt_s <= cfg.max_prior_dt_s && m.T_prev_curr.matrix().allFinite();
 }
@@ -86,8 +100,7 @@ std::int32_t deskewPoints(std::vector<LidarPoint>& points, std::int64_t utime, f
   for (LidarPoint& p : points) {
     const double u = std::clamp((p.dt + sweep) / sweep, 0.0, 1.0) * steps;
     const int k = std::min(static_cast<int>(u), steps - 1);
-    const float f = static_cast<float>(u - k);
-    p.p = ((1.0f - f) * R[k] + f * R[k + 1]) * p.p + (1.0f - f) * t[k] + f * t[k + 1];
+    p.p = blendedPose(R[k], R[k + 1], t[k], t[k + 1], static_cast<float>(u - k), p.p);
   }
   return (imu_q.empty() ? 0 : FeatureSet::kDeskewImu) | (use_motion ? FeatureSet::kDeskewMotion : 0);
 }

@@ -1,6 +1,6 @@
 #include "features/loam_features.hpp"
 
-#include "features/preprocess.hpp"
+#include "features/voxel_centroids.hpp"
 
 #include <algorithm>
 #include <cstring>
@@ -11,27 +11,31 @@ namespace {
 
 enum Label : std::uint8_t { kNone = 0, kEdge = 1, kFlat = 2 };
 
-// Sorted access to unique keys without sorting them all: only the first `prefix` are ordered up front
-// (the picks rarely need more: each pick suppresses at most 2 half_window neighbours); the rest is sorted
-// the first time it is reached. Same order as a full sort.
+// Sorted access to unique keys without sorting them all: only the first `prefix` are ordered up front (the
+// picks rarely need more: each pick suppresses at most 2 half_window neighbours); each time the ordered part
+// runs out, the next block, twice as long, is selected and sorted. Same order as a full sort.
 template <class Compare>
 class SortedPrefix {
  public:
-  SortedPrefix(std::vector<std::uint64_t>& keys, std::size_t prefix) : keys_(keys), sorted_(std::min(prefix, keys.size())) {
-    if (sorted_ < keys_.size()) std::nth_element(keys_.begin(), keys_.begin() + sorted_, keys_.end(), Compare{});
-    std::sort(keys_.begin(), keys_.begin() + sorted_, Compare{});
+  SortedPrefix(std::vector<std::uint64_t>& keys, std::size_t prefix) : keys_(keys), block_(std::max<std::size_t>(prefix, 1)) {
+    orderUpTo(block_);
   }
   std::uint64_t at(std::size_t k) {
-    if (k >= sorted_) {
-      std::sort(keys_.begin() + sorted_, keys_.end(), Compare{});
-      sorted_ = keys_.size();
-    }
+    while (k >= sorted_) orderUpTo(sorted_ + (block_ *= 2));
     return keys_[k];
   }
 
  private:
+  void orderUpTo(std::size_t end) {
+    end = std::min(end, keys_.size());
+    if (end < keys_.size()) std::nth_element(keys_.begin() + sorted_, keys_.begin() + end, keys_.end(), Compare{});
+    std::sort(keys_.begin() + sorted_, keys_.begin() + end, Compare{});
+    sorted_ = end;
+  }
+
   std::vector<std::uint64_t>& keys_;
-  std::size_t sorted_;
+  std::size_t block_;
+  std::size_t sorted_ = 0;
 };
 
 struct RingSelection {
@@ -41,6 +45,8 @@ struct RingSelection {
   int b, e;                        // ring span
   std::vector<std::uint8_t>& taken;  // picked or suppressed
   std::vector<std::uint8_t>& label;
+  std::vector<std::uint64_t>& edges;  // sort keys of one sector's candidates (reused: no allocation per sector)
+  std::vector<std::uint64_t>& flats;
 
   // Suppress neighbours of i on the same surface (stop at a gap larger than suppression_gap).
   void suppress(int i) const {
@@ -67,7 +73,8 @@ struct RingSelection {
   void sector(int sp, int ep, LoamFeatures& out) const {
     // Sort keys: smoothness bits (non-negative floats order like their bit patterns) above the index, so
     // a plain integer sort orders by smoothness with ties by index: fast and deterministic.
-    std::vector<std::uint64_t> edges, flats;
+    edges.clear();
+    flats.clear();
     for (int i = sp; i < ep; ++i) {
       std::uint32_t bits;
       std::memcpy(&bits, &s.smoothness[i], sizeof bits);
@@ -75,8 +82,8 @@ struct RingSelection {
       if (isEdge(i)) edges.push_back(key);
       else if (isFlat(i)) flats.push_back(key);
     }
-    SortedPrefix<std::greater<>> edge_order(edges, static_cast<std::size_t>(cfg.max_less_sharp) * (2 * cfg.half_window + 1));
-    SortedPrefix<std::less<>> flat_order(flats, static_cast<std::size_t>(cfg.max_flat) * (2 * cfg.half_window + 1) + 64);
+    SortedPrefix<std::greater<>> edge_order(edges, static_cast<std::size_t>(cfg.max_less_sharp) * 2);
+    SortedPrefix<std::less<>> flat_order(flats, static_cast<std::size_t>(cfg.max_flat) * 4);
     int picked = 0;
     for (std::size_t k = 0; k < edges.size() && picked < cfg.max_less_sharp; ++k) {
       const int i = static_cast<int>(edge_order.at(k) & 0xFFFFFFFFu);
@@ -104,20 +111,25 @@ struct RingSelection {
 LoamFeatures selectLoamFeatures(const RingCloud& c, const PointScores& s, const LoamConfig& cfg) {
   LoamFeatures out;
   std::vector<std::uint8_t> taken(c.points.size(), 0), label(c.points.size(), kNone);
-  std::vector<LidarPoint> less_flat;
-  less_flat.reserve(c.points.size());
+  std::vector<std::uint64_t> edges, flats;
+  // Less flat points go straight into the voxel grid (no copy of them all first); a leaf <= 0 keeps them all.
+  const bool downsample = cfg.less_flat_voxel > 0.0f;
+  VoxelCentroids grid(downsample ? cfg.less_flat_voxel : 1.0f, c.points.size());
   const int sectors = std::max(1, cfg.sectors);
   for (int r = 0; r < c.numRings(); ++r) {
     const int b = c.ring_begin[r], e = c.ring_begin[r + 1];
     const int sp0 = b + cfg.half_window, ep0 = e - cfg.half_window;  // span with complete windows
     if (ep0 <= sp0) continue;
-    RingSelection sel{c, s, cfg, b, e, taken, label};
+    RingSelection sel{c, s, cfg, b, e, taken, label, edges, flats};
     for (int k = 0; k < sectors; ++k)
       sel.sector(sp0 + (ep0 - sp0) * k / sectors, sp0 + (ep0 - sp0) * (k + 1) / sectors, out);
     for (int i = sp0; i < ep0; ++i)
-      if (s.usable[i] && label[i] != kEdge && !sel.isEdge(i)) less_flat.push_back(c.points[i]);
+      if (s.usable[i] && label[i] != kEdge && !sel.isEdge(i)) {
+        if (downsample) grid.add(c.points[i]);
+        else out.less_flat.push_back(c.points[i]);
+      }
   }
-  out.less_flat = voxelDownsample(less_flat, cfg.less_flat_voxel);
+  if (downsample) out.less_flat = grid.take();
   return out;
 }
 

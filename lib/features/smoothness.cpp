@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 
 namespace adit::features {
 namespace {
@@ -14,18 +16,33 @@ bool azimuthGap(const Eigen::Vector3f& a, const Eigen::Vector3f& b, float sin_ma
   return dot <= 0.0f || cross * cross > sin_max * sin_max * norms2;
 }
 
+// Prefix sums of one ring, reused from ring to ring (sized for the longest).
+struct RingPrefix {
+  std::vector<int> gaps;           // gaps[k]: gaps between consecutive points among b..b+k
+  std::vector<Eigen::Vector3d> P;  // P[k] = sum of the first k points
+  std::vector<double> C;           // C[k] = path length from b to b+k
+  std::vector<double> CC;          // CC[k] = sum of the first k path lengths
+};
+
 // Smoothness of points [b, e) of one ring in O(1) per point from prefix sums (doubles: a ring's sums reach
 // 1e5 m). The spread sum_j |p_j - p_i| is taken along the scan line (path length from p_i to p_j): equal to
 // the chord on straight runs and at corners, larger where noise makes the line zigzag, so noise alone reads
 // as less edge-like. Windows crossing a gap of missing returns are not evaluated.
-void scoreRing(const RingCloud& c, int b, int e, const LoamConfig& cfg, PointScores& s) {
+void scoreRing(const RingCloud& c, int b, int e, const LoamConfig& cfg, RingPrefix& prefix, PointScores& s) {
   const int w = cfg.half_window, n = e - b;
   if (w < 1 || w >= n) return;  // no complete window (a half_window < 1 would index before the ring)
   const float sin_max = std::sin(std::min(cfg.max_neighbor_gap_deg, 89.0f) * static_cast<float>(M_PI / 180.0));
-  std::vector<int> gaps(n, 0);           // gaps[k]: gaps between consecutive points among b..b+k
-  std::vector<Eigen::Vector3d> P(n + 1);  // P[k] = sum of the first k points
-  std::vector<double> C(n, 0.0);          // C[k] = path length from b to b+k
-  std::vector<double> CC(n + 1, 0.0);     // CC[k] = sum of the first k path lengths
+  std::vector<int>& gaps = prefix.gaps;
+  std::vector<Eigen::Vector3d>& P = prefix.P;
+  std::vector<double>& C = prefix.C;
+  std::vector<double>& CC = prefix.CC;
+  gaps.resize(n);  // every element below is written before it is read: no zero fill
+  P.resize(n + 1);
+  C.resize(n);
+  CC.resize(n + 1);
+  gaps[0] = 0;
+  C[0] = 0.0;
+  CC[0] = 0.0;
   P[0].setZero();
   for (int k = 0; k < n; ++k) {
     const Eigen::Vector3f& p = c.points[b + k].p;
@@ -58,11 +75,40 @@ void collectSecondDifferences(const RingCloud& c, int b, int e, float max_step, 
   }
 }
 
-float medianNoise(std::vector<float>& second) {
+// The k-th smallest of non-negative floats (what std::nth_element would put at k), by radix selection on
+// their bit patterns, which order like the values: per 11-bit digit, from the top, count, find the digit
+// holding rank k, keep only those values. No data-dependent branches (nth_element's partitioning of noise
+// mispredicts half of them).
+float kthSmallestNonNegative(const std::vector<float>& values, std::size_t k) {
+  std::vector<std::uint32_t> bits, keep;  // the candidates (all values, until the first digit is known)
+  const auto bitsOf = [](float v) {
+    std::uint32_t b;
+    std::memcpy(&b, &v, sizeof b);
+    return b;
+  };
+  const std::size_t n = values.size();
+  for (const int shift : {21, 10, 0}) {  // digits of bits 31..21, 20..10, 10..0
+    const bool first = shift == 21;
+    const std::size_t m = first ? n : bits.size();
+    const auto at = [&](std::size_t i) { return first ? bitsOf(values[i]) : bits[i]; };
+    std::size_t counts[2048] = {};
+    for (std::size_t i = 0; i < m; ++i) ++counts[(at(i) >> shift) & 0x7FF];
+    std::size_t digit = 0;
+    while (k >= counts[digit]) k -= counts[digit++];
+    keep.clear();
+    for (std::size_t i = 0; i < m; ++i)
+      if (((at(i) >> shift) & 0x7FF) == digit) keep.push_back(at(i));
+    bits.swap(keep);
+  }
+  float v;
+  std::memcpy(&v, &bits.front(), sizeof v);
+  return v;
+}
+
+float medianNoise(const std::vector<float>& second) {
   if (second.size() < 100) return 0.0f;
-  const auto mid = second.begin() + static_cast<long>(second.size() / 2);
-  std::nth_element(second.begin(), mid, second.end());
-  return *mid / 1.652f;  // median of |N(0, 6 sigma^2)| = 0.6745 sqrt(6) sigma
+  // median of |N(0, 6 sigma^2)| = 0.6745 sqrt(6) sigma
+  return kthSmallestNonNegative(second, second.size() / 2) / 1.652f;
 }
 
 // Marks the far side of depth jumps and beam-parallel points as unusable.
@@ -93,10 +139,11 @@ PointScores scorePoints(const RingCloud& c, const LoamConfig& cfg) {
   s.usable.assign(n, 1);
   std::vector<float> second;
   second.reserve(n);
+  RingPrefix prefix;
   for (std::size_t i = 0; i < n; ++i) s.range[i] = c.points[i].p.norm();
   for (int r = 0; r < c.numRings(); ++r) {
     const int b = c.ring_begin[r], e = c.ring_begin[r + 1];
-    scoreRing(c, b, e, cfg, s);
+    scoreRing(c, b, e, cfg, prefix, s);
     collectSecondDifferences(c, b, e, cfg.noise_max_step, second);
     markUnreliable(b, e, cfg, s);
     for (int i = b; i < e; ++i)

@@ -6,8 +6,18 @@
 namespace adit::msg {
 namespace {
 
+// std::lround (half away from zero) without the libm call: truncate, then step when the remainder (exact in
+// float) reaches one half. The scale keeps |q| <= 32767 for the points that are written, so the
+// truncation cannot overflow; anything larger goes to lround as before.
+long roundHalfAway(float q) {
+  if (!(std::fabs(q) < 1e9f)) return std::lround(q);
+  const long t = static_cast<long>(q);
+  const float rest = q - static_cast<float>(t);
+  return rest >= 0.5f ? t + 1 : rest <= -0.5f ? t - 1 : t;
+}
+
 std::int16_t count(float v, float scale) {
-  return static_cast<std::int16_t>(std::clamp(std::lround(v / scale), -32767L, 32767L));
+  return static_cast<std::int16_t>(std::clamp(roundHalfAway(v / scale), -32767L, 32767L));
 }
 
 }  // namespace

@@ -67,14 +67,13 @@ class FeatureNode : public runtime::Node {
       return;
     }
     processHeld();  // its prior never came: go on without it
-    LidarScan scan = m.scan;
     const bool prior_pending = odometry_seen_ && !sweeps_.empty() && !poses_.count(sweeps_.back());
     if (prior_pending) {
-      held_ = std::move(scan);
+      held_ = m.scan;  // the only copy of a sweep: the usual path reads the message in place
       count("held_for_prior");
       return;
     }
-    process(scan);
+    process(m.scan);
   }
 
   void processHeld() {
