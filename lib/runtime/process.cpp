@@ -1,5 +1,6 @@
 #include "runtime/process.hpp"
 
+#include "runtime/allocator.hpp"
 #include "runtime/status.hpp"
 
 #include <lcm/lcm-cpp.hpp>
@@ -94,6 +95,7 @@ void applyRemaps(Node& node, const std::vector<std::string>& remaps) {
 
 int runNodeProcess(int argc, char** argv, const std::string& name, const std::string& description,
                    const NodeFactory& factory) {
+  keepFreedMemoryForReuse();
   CLI::App app{description, "adit-" + name};
   ProcessOptions options;
   addProcessOptions(app, options);

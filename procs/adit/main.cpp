@@ -3,6 +3,7 @@
 #include "commands.hpp"
 
 #include "core/config.hpp"
+#include "runtime/allocator.hpp"
 
 #include <spdlog/spdlog.h>
 
@@ -25,6 +26,7 @@ void drawProgress(double fraction) {
 }
 
 int main(int argc, char** argv) {
+  adit::runtime::keepFreedMemoryForReuse();
   CLI::App app{"adit: real-time 3D mapping of underground roadways with a spinning lidar", "adit"};
   app.require_subcommand(1);
   spdlog::set_pattern("%H:%M:%S.%e %^%l%$ adit: %v");
