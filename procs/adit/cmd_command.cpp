@@ -11,6 +11,7 @@
 
 #include <chrono>
 #include <stdexcept>
+#include <vector>
 
 namespace {
 
@@ -33,7 +34,7 @@ void publishSaveMap(const CommandArgs& a) {
   c.header.seq = 0;
   c.command = "save_map";
   c.argument = a.name;
-  const adit::runtime::Bytes bytes = adit::msg::encode(c);
+  const std::vector<std::uint8_t> bytes = adit::msg::encode(c);
   if (lcm.publish(a.channel, bytes.data(), static_cast<unsigned int>(bytes.size())) != 0)
     throw std::runtime_error("cannot publish on " + a.channel);
   spdlog::info("sent save_map{} on {}", a.name.empty() ? "" : " " + a.name, a.channel);
