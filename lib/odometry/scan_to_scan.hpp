@@ -6,9 +6,9 @@
 
 #include "core/config_table.hpp"
 #include "core/types.hpp"
-#include "odometry/feature_fit.hpp"
-#include "odometry/pose_increment.hpp"
-#include "odometry/registration.hpp"
+#include "registration/feature_fit.hpp"
+#include "registration/pose_increment.hpp"
+#include "registration/solver.hpp"
 #include "odometry/ring_cloud.hpp"
 
 #include <optional>

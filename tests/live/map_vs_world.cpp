@@ -5,7 +5,7 @@
 // surface (bias below half the sampling spacing). Prints: points, mean distance (m), share beyond 0.2 m.
 #include "eval/trajectory_io.hpp"
 #include "io/pcd.hpp"
-#include "odometry/kdtree.hpp"
+#include "registration/kdtree.hpp"
 
 #include <cmath>
 #include <cstdio>

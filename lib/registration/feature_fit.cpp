@@ -1,4 +1,4 @@
-#include "odometry/feature_fit.hpp"
+#include "registration/feature_fit.hpp"
 
 #include <Eigen/Eigenvalues>
 

@@ -1,4 +1,4 @@
-#include "odometry/kdtree.hpp"
+#include "registration/kdtree.hpp"
 
 #include <algorithm>
 #include <numeric>
