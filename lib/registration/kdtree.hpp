@@ -1,11 +1,14 @@
-// A small static 3-D KD-tree for nearest-neighbour queries on one sweep's feature points.
+// A static 3-D KD-tree (nanoflann, leaves of up to 8 points) for nearest-neighbour queries: one sweep's
+// feature points in odometry, a keyframe submap in loop verification.
 //
-// Built once per sweep (O(n log n), median splits with std::nth_element, no randomness) and queried a few
-// thousand times. Only exact single-nearest queries are needed by scan-to-scan matching, so this is all it does.
+// Built once (median splits, no randomness) and queried a few thousand times. Deterministic: equal distances
+// keep the order in which the search met them, which depends only on the points. Copies share the
+// (immutable) index.
 #pragma once
 
 #include <Eigen/Core>
 
+#include <memory>
 #include <vector>
 
 namespace adit {
@@ -19,26 +22,23 @@ class KdTree3 {
   // max_sq_distance, skipping index `exclude`; -1 if there is none.
   int nearest(const Eigen::Vector3d& query, double max_sq_distance, int exclude = -1) const;
 
-  // Indices of up to k nearest points with squared distance below max_sq_distance, nearest first.
-  std::vector<int> nearestK(const Eigen::Vector3d& query, int k, double max_sq_distance) const;
+  // Indices of up to k nearest points with squared distance below max_sq_distance, nearest first, written
+  // into `out` (its capacity is reused: no allocation per query in a loop).
+  void nearestK(const Eigen::Vector3d& query, int k, double max_sq_distance, std::vector<int>& out) const;
+  std::vector<int> nearestK(const Eigen::Vector3d& query, int k, double max_sq_distance) const {
+    std::vector<int> out;
+    nearestK(query, k, max_sq_distance, out);
+    return out;
+  }
 
-  const Eigen::Vector3d& point(int index) const { return points_[static_cast<std::size_t>(index)]; }
-  std::size_t size() const { return points_.size(); }
-  bool empty() const { return points_.empty(); }
+  const Eigen::Vector3d& point(int index) const { return points()[static_cast<std::size_t>(index)]; }
+  std::size_t size() const { return index_ ? points().size() : 0; }
+  bool empty() const { return size() == 0; }
 
  private:
-  void build(int lo, int hi);
-  void search(int lo, int hi, const Eigen::Vector3d& q, int exclude, double& best_sq, int& best) const;
-
-  struct Candidate {
-    double sq;
-    int index;
-  };
-  void searchK(int lo, int hi, const Eigen::Vector3d& q, int k, double max_sq, std::vector<Candidate>& best) const;
-
-  std::vector<Eigen::Vector3d> points_;
-  std::vector<int> order_;  // tree layout: the node of range [lo, hi) is order_[(lo + hi) / 2]
-  std::vector<int> axis_;   // split axis of the node stored at each layout position
+  struct Index;
+  const std::vector<Eigen::Vector3d>& points() const;
+  std::shared_ptr<const Index> index_;
 };
 
 }  // namespace adit
