@@ -94,44 +94,55 @@ std::vector<DirectionalPrior> directionalPriors(const DegeneracyReport& d, const
   return priors;
 }
 
-void addPriors(Linearisation& lin, const std::vector<DirectionalPrior>& priors, const Vector6d& xi,
-               const Vector6d& target) {
+// The measurements' normal equations plus the priors' at xi.
+Linearisation withPriors(Linearisation lin, const std::vector<DirectionalPrior>& priors, const Vector6d& xi,
+                         const Vector6d& target) {
   for (const DirectionalPrior& p : priors) {
     const double r = p.weight * p.v.dot(xi - target);
     lin.H.noalias() += (p.weight * p.weight) * p.v * p.v.transpose();
     lin.g.noalias() += (p.weight * r) * p.v;
     lin.cost += 0.5 * r * r;
   }
+  return lin;
 }
 
-// Gauss-Newton from xi = 0 with the correspondences fixed. A step that raises the cost is halved (at most a
-// few times) rather than taken: Levenberg-Marquardt's safety at the price of one more linearisation.
-Vector6d gaussNewton(const LocalProblem& problem, const std::vector<DirectionalPrior>& priors, const Vector6d& target,
-                     const RobustKernel& kernel, int max_iterations, int& iterations, double& cost) {
+struct Solution {
   Vector6d xi = Vector6d::Zero();
-  Linearisation lin = linearise(problem, xi, kernel);
-  addPriors(lin, priors, xi, target);
-  iterations = 0;
+  Linearisation measurements;  // at xi, priors excluded (what information and degeneracy are reported from)
+  double cost = 0.0;           // with priors
+  int iterations = 0;
+};
+
+// Gauss-Newton from xi = 0 (measurements linearised there: at_zero) with the correspondences fixed. A step
+// that raises the cost is halved (at most a few times) rather than taken: Levenberg-Marquardt's safety at the
+// price of one more linearisation.
+Solution gaussNewton(const LocalProblem& problem, const Linearisation& at_zero,
+                     const std::vector<DirectionalPrior>& priors, const Vector6d& target, const RobustKernel& kernel,
+                     int max_iterations) {
+  Solution s;
+  s.measurements = at_zero;
+  Linearisation lin = withPriors(at_zero, priors, s.xi, target);
   for (int it = 0; it < max_iterations; ++it) {
-    ++iterations;
+    ++s.iterations;
     const Vector6d step = -(lin.H + 1e-12 * Matrix6d::Identity()).ldlt().solve(lin.g);
     if (!step.allFinite()) break;
-    Vector6d next = xi + step;
-    Linearisation next_lin = linearise(problem, next, kernel);
-    addPriors(next_lin, priors, next, target);
+    Vector6d next = s.xi + step;
+    Linearisation next_meas = linearise(problem, next, kernel);
+    Linearisation next_lin = withPriors(next_meas, priors, next, target);
     for (int halvings = 0; halvings < 4 && next_lin.cost > lin.cost; ++halvings) {
-      next = xi + (next - xi) * 0.5;
-      next_lin = linearise(problem, next, kernel);
-      addPriors(next_lin, priors, next, target);
+      next = s.xi + (next - s.xi) * 0.5;
+      next_meas = linearise(problem, next, kernel);
+      next_lin = withPriors(next_meas, priors, next, target);
     }
     if (next_lin.cost > lin.cost) break;  // no descent along the Gauss-Newton direction: xi is the minimum
-    const Vector6d moved = next - xi;
-    xi = next;
+    const Vector6d moved = next - s.xi;
+    s.xi = next;
+    s.measurements = next_meas;
     lin = next_lin;
     if (moved.head<3>().norm() < 1e-6 && moved.tail<3>().norm() < 1e-7) break;
   }
-  cost = lin.cost;
-  return xi;
+  s.cost = lin.cost;
+  return s;
 }
 
 // Zhang 2016's solution remapping: the solution's component along each degenerate eigen-direction is
@@ -190,12 +201,15 @@ RegistrationResult registerStep(const Correspondences& matches, const Eigen::Iso
   const Vector6d target = hold ? incrementBetween(T0, motion_prior) : Vector6d::Zero();
   const std::vector<DirectionalPrior> priors = hold ? directionalPriors(d0, config) : std::vector<DirectionalPrior>{};
 
-  Vector6d solution = gaussNewton(problem, priors, target, kernel, std::max(1, config.max_solver_iterations),
-                                  result.iterations, result.final_cost);
+  const Solution solved = gaussNewton(problem, at_T0, priors, target, kernel, std::max(1, config.max_solver_iterations));
+  result.iterations = solved.iterations;
+  result.final_cost = solved.cost;
+  Vector6d solution = solved.xi;
   if (!solution.allFinite()) return result;
-  if (hold && config.degeneracy_remap) remapDegenerate(solution, d0, target);
+  const bool remap = hold && config.degeneracy_remap;
+  if (remap) remapDegenerate(solution, d0, target);
   // Report information and degeneracy at the solution, from the measurements only.
-  const Linearisation at_solution = linearise(problem, solution, kernel);
+  const Linearisation at_solution = remap ? linearise(problem, solution, kernel) : solved.measurements;
   result.information = at_solution.H * info_scale;
   const Matrix6d H = config.degeneracy_from_planes_only ? Matrix6d(at_solution.H_planes * info_scale) : result.information;
   result.degeneracy = analyzeDegeneracy(H, config.degeneracy_ratio_translation, config.degeneracy_ratio_rotation);
