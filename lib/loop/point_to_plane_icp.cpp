@@ -1,66 +1,62 @@
 #include "loop/point_to_plane_icp.hpp"
 
 #include "core/geometry.hpp"
-
-#include <pcl/kdtree/kdtree_flann.h>
-#include <pcl/point_cloud.h>
-#include <pcl/point_types.h>
+#include "registration/jacobians.hpp"
+#include "registration/kdtree.hpp"
+#include "registration/robust_loss.hpp"
 
 #include <Eigen/Eigenvalues>
 
 #include <cmath>
+#include <limits>
 
 namespace adit {
 
 struct PlaneTarget::Impl {
-  pcl::PointCloud<pcl::PointXYZ>::Ptr planar{new pcl::PointCloud<pcl::PointXYZ>};
+  KdTree3 planar;  // planar target points (the registration core's KD-tree)
   std::vector<Eigen::Vector3d> normals;
-  pcl::KdTreeFLANN<pcl::PointXYZ> tree{false};  // unsorted results are fine for k = 1
 };
 
 PlaneTarget::PlaneTarget(const std::vector<Eigen::Vector3f>& points, const IcpConfig& config)
     : impl_(std::make_unique<Impl>()) {
-  pcl::PointCloud<pcl::PointXYZ>::Ptr all(new pcl::PointCloud<pcl::PointXYZ>);
+  std::vector<Eigen::Vector3d> finite;
+  finite.reserve(points.size());
   for (const auto& p : points)
-    if (p.allFinite()) all->push_back(pcl::PointXYZ(p.x(), p.y(), p.z()));
+    if (p.allFinite()) finite.push_back(p.cast<double>());
   const int k = std::max(3, config.normal_neighbors);
-  if (static_cast<int>(all->size()) < k) return;
-  pcl::KdTreeFLANN<pcl::PointXYZ> all_tree;
-  all_tree.setInputCloud(all);
-  std::vector<int> idx;
-  std::vector<float> sq;
-  for (const pcl::PointXYZ& p : all->points) {
-    if (all_tree.nearestKSearch(p, k, idx, sq) < k) continue;
+  if (static_cast<int>(finite.size()) < k) return;
+  const KdTree3 all(finite);
+  std::vector<Eigen::Vector3d> planar;
+  for (const Eigen::Vector3d& p : finite) {
+    const std::vector<int> idx = all.nearestK(p, k, std::numeric_limits<double>::infinity());
+    if (static_cast<int>(idx.size()) < k) continue;
     Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-    for (int i : idx) mean += all->points[static_cast<std::size_t>(i)].getVector3fMap().cast<double>();
+    for (int i : idx) mean += all.point(i);
     mean /= k;
     Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
     for (int i : idx) {
-      const Eigen::Vector3d d = all->points[static_cast<std::size_t>(i)].getVector3fMap().cast<double>() - mean;
+      const Eigen::Vector3d d = all.point(i) - mean;
       cov += d * d.transpose();
     }
     const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);
     const double total = eig.eigenvalues().sum();
     if (total <= 0.0 || eig.eigenvalues()[0] / total > config.max_surface_variation) continue;
-    impl_->planar->push_back(p);
+    planar.push_back(p);
     impl_->normals.push_back(eig.eigenvectors().col(0));
   }
-  if (!impl_->planar->empty()) impl_->tree.setInputCloud(impl_->planar);
+  impl_->planar = KdTree3(std::move(planar));
 }
 
 PlaneTarget::~PlaneTarget() = default;
 
-int PlaneTarget::planarPoints() const { return static_cast<int>(impl_->planar->size()); }
+int PlaneTarget::planarPoints() const { return static_cast<int>(impl_->planar.size()); }
 
 bool PlaneTarget::nearest(const Eigen::Vector3d& query, double max_distance, Eigen::Vector3d& point,
                           Eigen::Vector3d& normal) const {
-  if (impl_->planar->empty()) return false;
-  std::vector<int> idx(1);
-  std::vector<float> sq(1);
-  const pcl::PointXYZ q(static_cast<float>(query.x()), static_cast<float>(query.y()), static_cast<float>(query.z()));
-  if (impl_->tree.nearestKSearch(q, 1, idx, sq) < 1 || sq[0] > max_distance * max_distance) return false;
-  point = impl_->planar->points[static_cast<std::size_t>(idx[0])].getVector3fMap().cast<double>();
-  normal = impl_->normals[static_cast<std::size_t>(idx[0])];
+  const int i = impl_->planar.nearest(query, max_distance * max_distance);
+  if (i < 0) return false;
+  point = impl_->planar.point(i);
+  normal = impl_->normals[static_cast<std::size_t>(i)];
   return true;
 }
 
@@ -79,21 +75,20 @@ struct Linearisation {
 Linearisation linearise(const PlaneTarget& target, const std::vector<Eigen::Vector3d>& source,
                         const Eigen::Isometry3d& T, double max_distance, double inlier_residual) {
   Linearisation lin;
+  // Huber at the inlier scale: far matches pull, but not quadratically.
+  const RobustKernel huber{RobustLoss::kHuber, inlier_residual};
   Eigen::Vector3d q, n;
   for (const Eigen::Vector3d& s : source) {
     const Eigen::Vector3d p = T * s;
     if (!target.nearest(p, max_distance, q, n)) continue;
     const double r = n.dot(p - q);
-    Eigen::Matrix<double, 6, 1> J;
-    J.head<3>() = n;
-    J.tail<3>() = p.cross(n);
-    // Huber-like weight at the inlier scale: far matches pull, but not quadratically.
-    const double w = std::abs(r) <= inlier_residual ? 1.0 : inlier_residual / std::abs(r);
-    lin.H += w * J * J.transpose();
-    lin.g += w * J * r;
+    const Eigen::Matrix<double, 6, 1> J = planeRowLeft(n, p).transpose();
+    const double w = huber.weight(r * r);
+    lin.H.noalias() += (w * J) * J.transpose();
+    lin.g.noalias() += (w * r) * J;
     ++lin.correspondences;
     if (std::abs(r) <= inlier_residual) {
-      lin.H_inliers += J * J.transpose();
+      lin.H_inliers.noalias() += J * J.transpose();
       lin.inlier_sq_sum += r * r;
       ++lin.inliers;
     }

@@ -12,10 +12,19 @@ void GlobalMap::insert(const std::vector<Eigen::Vector3f>& sweep_points, const E
                        double max_range) {
   const Eigen::Isometry3f T = T_world_sweep.cast<float>();
   const float max_sq = static_cast<float>(max_range * max_range);
+  // Consecutive points of a sweep (scan order) often share a cell: reuse the last lookup (element pointers
+  // of an unordered_map stay valid across inserts).
+  VoxelKey last_key;
+  Cell* last = nullptr;
   for (const Eigen::Vector3f& p : sweep_points) {
     if (!p.allFinite() || p.squaredNorm() > max_sq) continue;
     const Eigen::Vector3f w = T * p;
-    Cell& c = cells_[voxelOf(w, resolution_)];
+    const VoxelKey key = voxelOf(w, resolution_);
+    if (last == nullptr || !(key == last_key)) {
+      last = &cells_[key];
+      last_key = key;
+    }
+    Cell& c = *last;
     // A few samples fix the centroid; capping the count keeps the float sum exact to ~1 mm even 1 km out.
     if (c.count >= kMaxSamplesPerCell) continue;
     c.sum += w;

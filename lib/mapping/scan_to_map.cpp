@@ -1,9 +1,9 @@
 #include "mapping/scan_to_map.hpp"
 
 #include "mapping/downsample.hpp"
-#include "odometry/feature_fit.hpp"
+#include "registration/feature_fit.hpp"
 #include "odometry/motion_compensation.hpp"
-#include "odometry/pose_increment.hpp"
+#include "registration/pose_increment.hpp"
 #include "odometry/scan_to_scan.hpp"
 
 namespace adit {

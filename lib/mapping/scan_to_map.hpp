@@ -8,8 +8,8 @@
 #include "core/types.hpp"
 #include "mapping/global_map.hpp"
 #include "mapping/voxel_map.hpp"
-#include "odometry/correspondences.hpp"
-#include "odometry/registration.hpp"
+#include "registration/correspondences.hpp"
+#include "registration/solver.hpp"
 
 #include <optional>
 

@@ -46,29 +46,46 @@ void VoxelMap::transform(const Eigen::Isometry3d& T) {
 }
 
 std::vector<Eigen::Vector3d> VoxelMap::nearest(const Eigen::Vector3d& q, int k, double max_distance) const {
-  std::vector<std::pair<double, Eigen::Vector3d>> best;  // ascending by distance, at most k
   if (k <= 0 || !q.allFinite()) return {};
-  best.reserve(static_cast<std::size_t>(k) + 1);
+  // The k best so far, ascending (a fixed buffer: no allocation while searching).
+  constexpr int kStack = 32;
+  std::pair<double, const Eigen::Vector3d*> stack[kStack];
+  std::vector<std::pair<double, const Eigen::Vector3d*>> heap;
+  auto* best = stack;
+  if (k > kStack) {
+    heap.resize(static_cast<std::size_t>(k));
+    best = heap.data();
+  }
+  int count = 0;
   const double max_sq = max_distance * max_distance;
+  const auto bound = [&] { return count < k ? max_sq : best[k - 1].first; };
   const VoxelKey c = voxelOf(q, voxel_size_);
-  for (int dx = -1; dx <= 1; ++dx)
-    for (int dy = -1; dy <= 1; ++dy)
-      for (int dz = -1; dz <= 1; ++dz) {
+  // Squared distance from q to the faces of its voxel, below and above, per axis: a neighbour voxel is
+  // skipped when its box is farther than the current k-th best (most of the 26 once the k best are found).
+  const Eigen::Vector3d lo = q - Eigen::Vector3d(c.x, c.y, c.z) * voxel_size_;
+  const Eigen::Vector3d hi = Eigen::Vector3d::Constant(voxel_size_) - lo;
+  const auto face_sq = [&](int axis, int d) { return d == 0 ? 0.0 : (d < 0 ? lo[axis] * lo[axis] : hi[axis] * hi[axis]); };
+  // The query's own voxel first (it holds the nearest points most often), then its neighbours.
+  static constexpr int kOrder[3] = {0, -1, 1};
+  for (int dx : kOrder)
+    for (int dy : kOrder)
+      for (int dz : kOrder) {
+        if (face_sq(0, dx) + face_sq(1, dy) + face_sq(2, dz) >= bound()) continue;
         const auto it = voxels_.find({c.x + dx, c.y + dy, c.z + dz});
         if (it == voxels_.end()) continue;
         for (const Eigen::Vector3d& p : it->second) {
           const double sq = (p - q).squaredNorm();
-          if (sq >= max_sq || (static_cast<int>(best.size()) == k && sq >= best.back().first)) continue;
+          if (!(sq < bound())) continue;
           // Insertion keeps the order stable for equal distances (first found wins): deterministic.
-          auto pos = std::upper_bound(best.begin(), best.end(), sq,
-                                      [](double v, const auto& e) { return v < e.first; });
-          best.insert(pos, {sq, p});
-          if (static_cast<int>(best.size()) > k) best.pop_back();
+          int i = std::min(count, k - 1);
+          for (; i > 0 && best[i - 1].first > sq; --i) best[i] = best[i - 1];
+          best[i] = {sq, &p};
+          count = std::min(count + 1, k);
         }
       }
   std::vector<Eigen::Vector3d> out;
-  out.reserve(best.size());
-  for (const auto& e : best) out.push_back(e.second);
+  out.reserve(static_cast<std::size_t>(count));
+  for (int i = 0; i < count; ++i) out.push_back(*best[i].second);
   return out;
 }
 

@@ -7,7 +7,7 @@
 #include "nodes/node_config.hpp"
 #include "nodes/run_state.hpp"
 #include "odometry/initial_guess.hpp"
-#include "odometry/pose_increment.hpp"
+#include "registration/pose_increment.hpp"
 #include "odometry/scan_to_scan.hpp"
 
 #include <spdlog/spdlog.h>

@@ -3,7 +3,7 @@
 #pragma once
 
 #include "core/types.hpp"
-#include "odometry/kdtree.hpp"
+#include "registration/kdtree.hpp"
 
 #include <map>
 #include <vector>

@@ -1,8 +1,8 @@
 #include "odometry/scan_to_scan.hpp"
 
-#include "odometry/feature_fit.hpp"
+#include "registration/feature_fit.hpp"
 #include "odometry/motion_compensation.hpp"
-#include "odometry/pose_increment.hpp"
+#include "registration/pose_increment.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -1,14 +1,15 @@
 // Scan-to-scan lidar odometry (A-LOAM laserOdometry, with the known defects fixed): registers each sweep's
 // sharp edges and flat surfaces against the previous sweep's less-sharp / less-flat points, point-to-line and
-// point-to-plane in Ceres, correspondences recomputed every outer round, degeneracy measured from the
-// Jacobian and held to the motion model. Deterministic: the output depends only on the inputs and config.
+// point-to-plane with the registration core (lib/registration), correspondences recomputed every outer
+// round, degeneracy measured from the information matrix and held to the motion model. Deterministic: the
+// output depends only on the inputs and config.
 #pragma once
 
 #include "core/config_table.hpp"
 #include "core/types.hpp"
-#include "odometry/feature_fit.hpp"
-#include "odometry/pose_increment.hpp"
-#include "odometry/registration.hpp"
+#include "registration/feature_fit.hpp"
+#include "registration/pose_increment.hpp"
+#include "registration/solver.hpp"
 #include "odometry/ring_cloud.hpp"
 
 #include <optional>

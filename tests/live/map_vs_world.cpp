@@ -9,7 +9,7 @@
 #include "eval/association.hpp"
 #include "eval/trajectory_io.hpp"
 #include "io/pcd.hpp"
-#include "odometry/kdtree.hpp"
+#include "registration/kdtree.hpp"
 
 #include <cmath>
 #include <cstdio>

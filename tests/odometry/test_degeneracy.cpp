@@ -2,7 +2,7 @@
 // reported in the covariance, and held to the motion model so a wrong seed or weak, biased information does
 // not drag the estimate along the axis.
 #include "core/geometry.hpp"
-#include "odometry/degeneracy.hpp"
+#include "registration/degeneracy.hpp"
 #include "odometry/scan_to_scan.hpp"
 #include "synthetic_world.hpp"
 

@@ -1,20 +1,24 @@
-// One Gauss-Newton round of point-to-line / point-to-plane registration with Ceres, shared by scan-to-scan
-// odometry and scan-to-map mapping. The caller finds correspondences at a linearisation pose T0, this solves
-// for the pose, measures degeneracy from the Jacobian and, if asked, holds degenerate directions to a
-// motion-model prior. The caller recomputes correspondences at the new pose and calls again (outer loop).
+// One correspondence round of point-to-line / point-to-plane registration, shared by scan-to-scan odometry
+// and scan-to-map mapping: a hand-written 6-DoF Gauss-Newton with robust weights (IRLS) and analytic
+// Jacobians over T = T0 * Exp(xi) (pose_increment.hpp). The caller finds correspondences at a linearisation
+// pose T0; this solves for the pose, measures degeneracy from the information matrix and, if asked, holds
+// degenerate directions to a motion-model prior (a directional residual, then Zhang 2016's solution
+// remapping). The caller recomputes correspondences at the new pose and calls again (outer loop).
 #pragma once
 
 #include "core/config_table.hpp"
 #include "core/types.hpp"
-#include "odometry/correspondences.hpp"
-#include "odometry/degeneracy.hpp"
+#include "registration/correspondences.hpp"
+#include "registration/degeneracy.hpp"
 
 #include <string>
 
 namespace adit {
 
 struct RegistrationConfig {
-  // Ceres iterations per outer round. Correspondences are fixed inside a round, so a few suffice.
+  // Gauss-Newton iterations per outer round (the key kept its name from the Ceres solver it replaced; a
+  // round also stops when a step moves the pose by less than 1e-6 m / 1e-7 rad). Correspondences are fixed
+  // inside a round, so a few suffice.
   int max_solver_iterations = 5;
   // Robust loss: "huber", "cauchy" or "none"; scale in metres of residual. 0.1 m is A-LOAM's Huber scale:
   // residuals beyond ~10 cm (wrong correspondences, moving objects) lose influence.
@@ -40,7 +44,7 @@ struct RegistrationConfig {
   bool degeneracy_from_planes_only = true;
   // Stiffness of that prior relative to the largest eigenvalue of its block: 1 pins the direction to the
   // prior as firmly as the best-observed direction is pinned by the data (Zhang 2016's solution remapping
-  // in effect, but expressed as a residual so Ceres handles it).
+  // in effect, but expressed as a residual inside the solve).
   double degeneracy_prior_strength = 1.0;
   // After solving, set the solution's component along each degenerate direction to the prior's (Zhang
   // 2016's solution remapping). The soft prior above alone leaks toward what the measurements say, and the
@@ -63,7 +67,7 @@ struct RegistrationResult {
   Matrix6d information = Matrix6d::Zero();  // measurements only, lidar-frame tangent at `pose`
   DegeneracyReport degeneracy;                // see degeneracy_from_planes_only
   int iterations = 0;
-  double final_cost = 0.0;
+  double final_cost = 0.0;  // 1/2 sum of robust costs (and priors) at the last iterate
   int num_correspondences = 0;
 };
 

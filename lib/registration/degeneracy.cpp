@@ -1,4 +1,4 @@
-#include "odometry/degeneracy.hpp"
+#include "registration/degeneracy.hpp"
 
 #include <Eigen/Eigenvalues>
 

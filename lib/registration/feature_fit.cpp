@@ -1,4 +1,4 @@
-#include "odometry/feature_fit.hpp"
+#include "registration/feature_fit.hpp"
 
 #include <Eigen/Eigenvalues>
 
@@ -20,7 +20,11 @@ Moments moments(const std::vector<Eigen::Vector3d>& points) {
   Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
   for (const auto& p : points) cov += (p - m.centroid) * (p - m.centroid).transpose();
   cov /= static_cast<double>(points.size());
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);
+  // Closed form (Eigen's computeDirect): several times faster than the iterative QR solver. What is used is
+  // the eigenvector of a well-separated eigenvalue (a plane's normal, a line's direction) of a centred,
+  // metre-scale covariance, where the closed form is accurate (accuracy table in the README unchanged).
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
+  eig.computeDirect(cov);
   m.eigenvalues = eig.eigenvalues();
   m.eigenvectors = eig.eigenvectors();
   return m;

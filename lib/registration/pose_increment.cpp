@@ -1,4 +1,4 @@
-#include "odometry/pose_increment.hpp"
+#include "registration/pose_increment.hpp"
 
 #include "core/geometry.hpp"
 

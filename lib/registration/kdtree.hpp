@@ -1,0 +1,44 @@
+// A static 3-D KD-tree (nanoflann, leaves of up to 8 points) for nearest-neighbour queries: one sweep's
+// feature points in odometry, a keyframe submap in loop verification.
+//
+// Built once (median splits, no randomness) and queried a few thousand times. Deterministic: equal distances
+// keep the order in which the search met them, which depends only on the points. Copies share the
+// (immutable) index.
+#pragma once
+
+#include <Eigen/Core>
+
+#include <memory>
+#include <vector>
+
+namespace adit {
+
+class KdTree3 {
+ public:
+  KdTree3() = default;
+  explicit KdTree3(std::vector<Eigen::Vector3d> points);
+
+  // Index (into the points given at construction) of the nearest point with squared distance below
+  // max_sq_distance, skipping index `exclude`; -1 if there is none.
+  int nearest(const Eigen::Vector3d& query, double max_sq_distance, int exclude = -1) const;
+
+  // Indices of up to k nearest points with squared distance below max_sq_distance, nearest first, written
+  // into `out` (its capacity is reused: no allocation per query in a loop).
+  void nearestK(const Eigen::Vector3d& query, int k, double max_sq_distance, std::vector<int>& out) const;
+  std::vector<int> nearestK(const Eigen::Vector3d& query, int k, double max_sq_distance) const {
+    std::vector<int> out;
+    nearestK(query, k, max_sq_distance, out);
+    return out;
+  }
+
+  const Eigen::Vector3d& point(int index) const { return points()[static_cast<std::size_t>(index)]; }
+  std::size_t size() const { return index_ ? points().size() : 0; }
+  bool empty() const { return size() == 0; }
+
+ private:
+  struct Index;
+  const std::vector<Eigen::Vector3d>& points() const;
+  std::shared_ptr<const Index> index_;
+};
+
+}  // namespace adit
