@@ -9,6 +9,8 @@
 //      (Mahalanobis gate), and
 //   4. it agrees with an accepted loop nearby, or with min_consistent_loops - 1 other pending loops.
 // Roadways are repetitive: a false loop is worse than a missed one, and the defaults lean that way.
+// Steps 2-4 and the graph optimisation run as a job on a worker, applied at a fixed later sweep
+// (loop/loop_job.hpp): the sweeps never wait for ICP unless the job overruns loop.apply_delay_s.
 #pragma once
 
 #include "core/config_table.hpp"
@@ -18,6 +20,7 @@
 #include "loop/pose_graph.hpp"
 #include "loop/scan_context_database.hpp"
 
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -43,6 +46,13 @@ struct LoopCloserConfig {
   int exclude_recent_keyframes = 50;      // never match the newest N keyframes (~50 m of roadway)
   double exclude_recent_seconds = 30.0;   // nor those from the last T seconds (a robot standing still)
   int cooldown_keyframes = 3;             // after an accepted loop, skip detection for this many keyframes
+
+  // --- scheduling (loop/loop_job.hpp) ---
+  // Verification and graph optimisation run as a job; its outcome is applied at the first sweep this much
+  // sensor time after the keyframe (0: within the same sweep, the single-threaded schedule). The output
+  // depends only on the input; the delay is how long the worker may take before the sweeps wait for it.
+  double apply_delay_s = 2.0;
+  bool worker_thread = true;  // run the jobs on a worker thread (false: inline, same results)
 
   // --- verification ---
   LoopVerifierConfig verifier;
@@ -91,6 +101,8 @@ struct LoopCloserStats {
   int optimizations = 0;
 };
 
+class LoopScheduler;
+
 class LoopCloser {
  public:
   struct Result {
@@ -104,11 +116,19 @@ class LoopCloser {
   };
 
   explicit LoopCloser(const LoopCloserConfig& config = {});
+  ~LoopCloser();  // waits for the job running on the worker
+  LoopCloser(LoopCloser&&) noexcept;
+  LoopCloser& operator=(LoopCloser&&) noexcept;
 
   // cloud: deskewed sweep in the lidar frame at mapped.utime. keypoints are accepted for API compatibility with
   // LinK3D seeding but not used yet.
   Result process(const PoseEstimate& mapped, const LidarScan& cloud,
                  const std::vector<Eigen::Vector3f>* keypoints = nullptr);
+  // End of input: applies every job still in flight (waiting for the worker).
+  Result finish();
+  // Loop jobs posted but not applied yet, and the wall time (ms, measurement only) sweeps waited for them.
+  std::size_t jobsInFlight() const;
+  double waitedMs() const;
 
   // Per-sweep poses corrected by interpolating (in time) the corrections of the surrounding keyframes.
   Trajectory correctedTrajectory(const Trajectory& uncorrected) const;
@@ -141,22 +161,22 @@ class LoopCloser {
   bool isKeyframe(const Eigen::Isometry3d& pose) const;
   void addKeyframe(const PoseEstimate& mapped, const LidarScan& cloud);
   Matrix6d stepCovariance(const Eigen::Isometry3d& new_pose) const;
-  std::vector<LoopConstraint> detectLoops(int query);
-  std::optional<LoopConstraint> verifyCandidate(int query, const ScanContextCandidate& candidate);
-  std::vector<LoopConstraint> admit(const LoopConstraint& loop);
-  bool pairConsistent(const LoopConstraint& a, const LoopConstraint& b) const;
-  Matrix6d loopCovariance() const;
+  void submitJob(int query);
+  void applyDue(std::int64_t utime, bool all, Result& result);
+  LoopScheduler& scheduler();
 
   LoopCloserConfig config_;
   std::vector<Keyframe> keyframes_;
   OdometryChain chain_;
   PoseGraph graph_;
   ScanContextDatabase database_;
+  // As of the newest applied job (the jobs keep their own book, loop/loop_job.hpp): what checkpoints save.
   std::vector<LoopConstraint> accepted_;
   std::vector<LoopConstraint> pending_;
   std::vector<std::pair<Eigen::Isometry3d, Matrix6d>> sweeps_since_keyframe_;  // pose, covariance
   int last_loop_query_ = -1000000;
   LoopCloserStats stats_;
+  std::unique_ptr<LoopScheduler> scheduler_;  // created with the first job
 };
 
 }  // namespace adit

@@ -63,6 +63,8 @@ const ConfigTable<LoopCloserConfig>& loopCloserConfigTable() {
      .add("exclude_recent_keyframes", &K::exclude_recent_keyframes, between(0, 1000000), "keyframes", "never match the newest N keyframes")
      .add("exclude_recent_seconds", &K::exclude_recent_seconds, atLeast(0), "s", "nor those from the last T seconds")
      .add("cooldown_keyframes", &K::cooldown_keyframes, between(0, 1000000), "keyframes", "after an accepted loop, skip detection this long")
+     .add("apply_delay_s", &K::apply_delay_s, between(0, 3600), "s", "a loop job's outcome is applied at the first sweep this much later (0: same sweep)")
+     .add("worker_thread", &K::worker_thread, anyValue(), "", "verify and optimise on a worker thread (same results either way)")
      .nest(&K::verifier, verifierTable())
      .add("odometry_translation_sigma", &K::odometry_translation_sigma, above(0), "m/sqrt(m)", "odometry step noise added per sqrt of metres travelled")
      .add("odometry_rotation_sigma", &K::odometry_rotation_sigma, above(0), "rad/sqrt(m)", "same for rotation")

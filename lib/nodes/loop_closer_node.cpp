@@ -73,6 +73,8 @@ class LoopCloserNode : public runtime::Node, public WritesProducts {
 
  protected:
   void onFinish() override {
+    // Loop jobs still in flight are applied (and published) before anything is saved, live and in replay.
+    if (!uncorrected_.empty()) publishResult(uncorrected_.back().utime, closer_.finish());
     if (!state_.live()) return;  // replay writes its products itself
     saveProducts({});  // first: what the user asked for, before the stop's grace time runs out
     checkpoint();
@@ -88,16 +90,15 @@ class LoopCloserNode : public runtime::Node, public WritesProducts {
     const LidarScan cloud = msg::featuresOf(m).cloud;
     uncorrected_.push_back({mapped.utime, mapped.pose});
     const LoopCloser::Result result = closer_.process(mapped, cloud);
-    for (const LoopConstraint& loop : result.loops) {
-      adit::loop_closure_t out = msg::toMessage(loop, mapped.utime);
-      publish("loop", out);
-    }
-    if (result.graph_updated) publishGraph(mapped.utime, result);
+    publishResult(mapped.utime, result);
     if (const auto update = updates_.update(mapped.utime, closer_)) publishMapUpdate(*update);
     const LoopCloserStats& s = closer_.stats();
     const bool periodic = result.keyframe_added && checkpoint_keyframes_ > 0 && s.keyframes % checkpoint_keyframes_ == 0;
     if (state_.live() && (periodic || result.graph_updated)) checkpoint();
     if (state_.live()) reportCheckpoints();
+    // Wall time the sweeps waited for the loop worker: STATUS only (replay's products never carry it).
+    setCount("loop_jobs_in_flight", static_cast<std::int64_t>(closer_.jobsInFlight()));
+    setCount("loop_wait_ms", static_cast<std::int64_t>(closer_.waitedMs()));
     setCount("keyframes", s.keyframes);
     setCount("loop_candidates", s.candidates);
     setCount("loops_accepted", s.accepted);
@@ -106,6 +107,14 @@ class LoopCloserNode : public runtime::Node, public WritesProducts {
     setCount("rejected_odometry_gate", s.rejected_odometry);
     setCount("rejected_pairwise", s.rejected_pairwise);
     setCount("invalid_sweeps", s.invalid_sweeps);
+  }
+
+  void publishResult(std::int64_t utime, const LoopCloser::Result& result) {
+    for (const LoopConstraint& loop : result.loops) {
+      adit::loop_closure_t out = msg::toMessage(loop, utime);
+      publish("loop", out);
+    }
+    if (result.graph_updated) publishGraph(utime, result);
   }
 
   // save_map [NAME]: the corrected map, trajectory and graph into the run folder, as NAME.pcd / .tum / .g2o

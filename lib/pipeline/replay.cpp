@@ -13,6 +13,7 @@
 
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
+#include <sys/resource.h>
 
 #include <chrono>
 #include <filesystem>
@@ -38,20 +39,29 @@ double peakMemoryMb() {
   return 0.0;
 }
 
+double processCpuSeconds() {
+  rusage u{};
+  if (getrusage(RUSAGE_SELF, &u) != 0) return 0.0;
+  const auto seconds = [](const timeval& t) { return static_cast<double>(t.tv_sec) + static_cast<double>(t.tv_usec) * 1e-6; };
+  return seconds(u.ru_utime) + seconds(u.ru_stime);
+}
+
 namespace {
 
 std::string timingJson(const ReplayReport& r) {
   std::string out = "{\n  \"stages\": {";
   for (std::size_t i = 0; i < r.timing.size(); ++i) {
     const StageTiming& t = r.timing[i];
-    out += fmt::format("{}\n    \"{}\": {{\"calls\": {}, \"median_ms\": {:.3f}, \"p95_ms\": {:.3f}, \"max_ms\": {:.3f}}}",
-                       i ? "," : "", t.stage, t.calls, t.median_ms, t.p95_ms, t.max_ms);
+    out += fmt::format("{}\n    \"{}\": {{\"calls\": {}, \"median_ms\": {:.3f}, \"p95_ms\": {:.3f}, \"max_ms\": {:.3f}, "
+                       "\"cpu_median_ms\": {:.3f}, \"cpu_p95_ms\": {:.3f}, \"wall_total_ms\": {:.1f}, \"cpu_total_ms\": {:.1f}}}",
+                       i ? "," : "", t.stage, t.calls, t.median_ms, t.p95_ms, t.max_ms, t.cpu_median_ms, t.cpu_p95_ms,
+                       t.wall_total_ms, t.cpu_total_ms);
   }
   out += fmt::format(
       "\n  }},\n  \"sweeps\": {},\n  \"sensor_seconds\": {:.3f},\n  \"wall_seconds\": {:.3f},\n"
-      "  \"realtime_factor\": {:.2f},\n  \"peak_memory_mb\": {:.1f}\n}}\n",
+      "  \"realtime_factor\": {:.2f},\n  \"peak_memory_mb\": {:.1f},\n  \"process_cpu_seconds\": {:.3f}\n}}\n",
       r.sweeps, r.sensor_seconds, r.wall_seconds, r.wall_seconds > 0 ? r.sensor_seconds / r.wall_seconds : 0.0,
-      r.peak_memory_mb);
+      r.peak_memory_mb, r.process_cpu_seconds);
   return out;
 }
 
@@ -63,6 +73,7 @@ std::vector<std::unique_ptr<runtime::Node>> buildNodes(const ReplayOptions& opti
       continue;
     nodes.push_back(nodes::makeNode(name, options.config));
     nodes.back()->timing().setCapacity(0);  // keep every sample for timing.json
+    nodes.back()->cpuTiming().setCapacity(0);
     report.stages_run.push_back(name);
   }
   return nodes;
@@ -162,12 +173,15 @@ ReplayReport runReplay(const ReplayOptions& options) {
   report.products.push_back(output.path());
   for (const auto& node : nodes) {
     const auto& t = node->timing();
-    report.timing.push_back({node->name(), t.size(), t.quantile(0.5), t.quantile(0.95), t.max()});
+    const auto& cpu = node->cpuTiming();
+    report.timing.push_back({node->name(), t.size(), t.quantile(0.5), t.quantile(0.95), t.max(), cpu.quantile(0.5),
+                             cpu.quantile(0.95), node->wallMsTotal(), node->cpuMsTotal()});
     report.stage_errors += node->health().errors + node->health().drops;
   }
   report.sensor_seconds = first_utime >= 0 ? static_cast<double>(last_utime - first_utime) * 1e-6 : 0.0;
   report.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
   report.peak_memory_mb = peakMemoryMb();
+  report.process_cpu_seconds = processCpuSeconds();
   writeProducts(nodes, options.out_dir, report.products);
   const fs::path timing_path = fs::path(options.out_dir) / "timing.json";
   io::writeFileAtomically(timing_path.string(), timingJson(report));

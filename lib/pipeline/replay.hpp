@@ -38,7 +38,9 @@ struct ReplayOptions {
 struct StageTiming {
   std::string stage;
   std::size_t calls = 0;
-  double median_ms = 0, p95_ms = 0, max_ms = 0;
+  double median_ms = 0, p95_ms = 0, max_ms = 0;  // wall time of the stage's main input (a sweep)
+  double cpu_median_ms = 0, cpu_p95_ms = 0;       // CPU time of the same calls (the stage's thread)
+  double wall_total_ms = 0, cpu_total_ms = 0;     // over every input of the stage
 };
 
 struct ReplayReport {
@@ -52,6 +54,7 @@ struct ReplayReport {
   double sensor_seconds = 0;      // span of sensor time in the input
   double wall_seconds = 0;
   double peak_memory_mb = 0;
+  double process_cpu_seconds = 0;  // user + system of every thread of this process (getrusage)
   std::vector<StageTiming> timing;
   std::vector<std::string> products;  // files written
 };
@@ -61,6 +64,8 @@ ReplayReport runReplay(const ReplayOptions& options);
 
 // Peak resident memory of this process in MB (VmHWM), 0 if unknown.
 double peakMemoryMb();
+// User + system CPU seconds of this process, every thread.
+double processCpuSeconds();
 
 }  // namespace pipeline
 }  // namespace adit

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <ctime>
 #include <limits>
 #include <stdexcept>
 
@@ -32,12 +33,21 @@ void Node::advertise(const std::string& port, const std::string& default_channel
   seq_.emplace(port, 0);
 }
 
+// CPU time of the calling thread in ms (CLOCK_THREAD_CPUTIME_ID): what a stage costs on a loaded machine,
+// where wall time also counts the other processes. Monitoring only.
+double threadCpuMs() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return static_cast<double>(t.tv_sec) * 1e3 + static_cast<double>(t.tv_nsec) * 1e-6;
+}
+
 void Node::deliver(const std::string& channel, const std::uint8_t* data, std::size_t size, Sink& sink) {
   for (auto& kv : inputs_) {
     if (channels_.at(kv.first) != channel) continue;
     ++health_.inputs;
     sink_ = &sink;
     const auto t0 = std::chrono::steady_clock::now();  // monitoring only: never feeds an algorithm
+    const double cpu0 = threadCpuMs();
     try {
       kv.second.handle(data, size);
     } catch (const std::exception& e) {
@@ -45,8 +55,14 @@ void Node::deliver(const std::string& channel, const std::uint8_t* data, std::si
       reportError("stage_exception", std::string("stage failed on ") + channel + ": " + e.what());
     }
     const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-    if (kv.first == primary_port_) timing_.add(ms);
+    const double cpu_ms = threadCpuMs() - cpu0;
+    if (kv.first == primary_port_) {
+      timing_.add(ms);
+      cpu_timing_.add(cpu_ms);
+    }
     health_.busy_s += ms * 1e-3;
+    wall_ms_total_ += ms;
+    cpu_ms_total_ += cpu_ms;
     sink_ = nullptr;
   }
 }

@@ -63,6 +63,8 @@ class Sink {
   virtual void publish(const std::string& channel, const Bytes& data, std::int64_t utime) = 0;
 };
 
+double threadCpuMs();  // CPU time of the calling thread, ms (monitoring only)
+
 class Node {
  public:
   explicit Node(std::string name) : name_(std::move(name)) {}
@@ -87,6 +89,12 @@ class Node {
   // Processing time of the node's first input (its main one: a sweep, not the IMU samples in between).
   const TimingWindow& timing() const { return timing_; }
   TimingWindow& timing() { return timing_; }
+  // The same calls' CPU time of the delivering thread (a stage's own worker threads are not in it), and the
+  // totals over every input (ms; monitoring only).
+  const TimingWindow& cpuTiming() const { return cpu_timing_; }
+  TimingWindow& cpuTiming() { return cpu_timing_; }
+  double wallMsTotal() const { return wall_ms_total_; }
+  double cpuMsTotal() const { return cpu_ms_total_; }
   // A short word for STATUS ("running", "behind", ...); subclasses may refine it.
   virtual std::string state() const { return "running"; }
 
@@ -156,6 +164,8 @@ class Node {
   std::map<std::string, std::int64_t> seq_;      // output port -> next sequence number
   Health health_;
   TimingWindow timing_;
+  TimingWindow cpu_timing_;
+  double wall_ms_total_ = 0, cpu_ms_total_ = 0;
   Sink* sink_ = nullptr;  // valid during deliver()/finish()
   std::int64_t max_time_gap_us_ = 1'000'000;
   InputChecks checks_;

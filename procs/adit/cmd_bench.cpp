@@ -1,11 +1,14 @@
 // adit bench ablation <log> --gt <gt>: the paper's before/after comparison on one log, same binaries:
 //   (a) plain A-LOAM, (b) + LinK3D, (c) + LinK3D + Scan Context loop closure; one APE table.
-// adit bench pipeline [--sensor vlp16|hdl64] [--log LOG]: per-stage ms per sweep (median, p95), throughput,
-//   real-time factor and peak memory of the whole pipeline.
+// adit bench pipeline [--sensor vlp16|hdl64] [--log LOG] [--json FILE]: per-stage wall and CPU ms per sweep
+//   (median, p95), throughput, real-time factor and peak memory of the whole pipeline.
+// adit bench compare a.json b.json [--tolerance PCT]: one line per figure with its change; regressions flagged.
 #include "commands.hpp"
 
 #include "eval/report.hpp"
 #include "eval/trajectory_io.hpp"
+#include "io/atomic_file.hpp"
+#include "pipeline/bench_figures.hpp"
 #include "pipeline/run_summary.hpp"
 #include "runtime/process.hpp"
 #include "sources/sim_source.hpp"
@@ -81,7 +84,7 @@ void registerAblation(CLI::App& bench) {
 
 void registerPipelineBench(CLI::App& bench) {
   struct Args {
-    std::string sensor = "vlp16", log, world = "roadway-loop";
+    std::string sensor = "vlp16", log, world = "roadway-loop", json;
     std::vector<std::string> configs;
     double duration_s = 60;
   };
@@ -92,6 +95,7 @@ void registerPipelineBench(CLI::App& bench) {
   cmd->add_option("--duration", a->duration_s, "Simulated seconds")->check(CLI::PositiveNumber);
   cmd->add_option("--log", a->log, "Time this log instead of a simulation")->check(CLI::ExistingFile);
   cmd->add_option("--config", a->configs, "Configuration (default launch/config/pipeline.yaml)");
+  cmd->add_option("--json", a->json, "Also write the figures to this JSON file (for adit bench compare)");
   cmd->callback([a] {
     const fs::path root = aditRoot();
     std::vector<std::string> configs = a->configs;
@@ -115,13 +119,53 @@ void registerPipelineBench(CLI::App& bench) {
     }
     const auto r = adit::pipeline::runReplay(options);
     fs::remove_all(options.out_dir);
-    fmt::print("pipeline benchmark: {} ({} sweeps), one thread\n", input, r.sweeps);
-    fmt::print("  {:<12} {:>10} {:>10} {:>10}\n", "stage", "median ms", "p95 ms", "max ms");
-    for (const auto& t : r.timing) fmt::print("  {:<12} {:>10.2f} {:>10.2f} {:>10.2f}\n", t.stage, t.median_ms, t.p95_ms, t.max_ms);
-    const double per_sweep = r.sweeps ? r.wall_seconds * 1e3 / static_cast<double>(r.sweeps) : 0.0;
+    fmt::print("pipeline benchmark: {} ({} sweeps)\n", input, r.sweeps);
+    fmt::print("  {:<12} {:>10} {:>10} {:>10} {:>10} {:>10}\n", "stage", "wall med", "wall p95", "wall max", "cpu med",
+               "cpu/sweep");
+    const double sweeps = r.sweeps > 0 ? static_cast<double>(r.sweeps) : 1.0;
+    for (const auto& t : r.timing)
+      fmt::print("  {:<12} {:>10.2f} {:>10.2f} {:>10.2f} {:>10.2f} {:>10.2f}\n", t.stage, t.median_ms, t.p95_ms, t.max_ms,
+                 t.cpu_median_ms, t.cpu_total_ms / sweeps);
+    const double per_sweep = r.wall_seconds * 1e3 / sweeps;
+    fmt::print("  (ms; cpu = CPU time of the stage's own thread: the loop closer's worker is not in it)\n");
     fmt::print("  end to end: {:.1f} ms per sweep (incl. simulation when simulated), {:.1f} sweeps/s, {:.1f}x real time, "
-               "peak memory {:.0f} MB\n", per_sweep, per_sweep > 0 ? 1e3 / per_sweep : 0.0,
-               r.wall_seconds > 0 ? r.sensor_seconds / r.wall_seconds : 0.0, r.peak_memory_mb);
+               "process CPU {:.1f} ms per sweep (every thread), peak memory {:.0f} MB\n", per_sweep,
+               per_sweep > 0 ? 1e3 / per_sweep : 0.0, r.wall_seconds > 0 ? r.sensor_seconds / r.wall_seconds : 0.0,
+               r.process_cpu_seconds * 1e3 / sweeps, r.peak_memory_mb);
+    if (!a->json.empty()) {
+      adit::io::writeFileAtomically(a->json, adit::pipeline::benchFiguresJson(adit::pipeline::benchFigures(r), input));
+      fmt::print("  figures written to {}\n", a->json);
+    }
+  });
+}
+
+void registerCompare(CLI::App& bench) {
+  struct Args {
+    std::string before, after;
+    double tolerance_pct = 10.0;
+  };
+  auto a = std::make_shared<Args>();
+  auto* cmd = bench.add_subcommand("compare", "Compare two `adit bench pipeline --json` files, one line per figure; "
+                                              "exit status 1 when a figure got worse by more than the tolerance");
+  cmd->add_option("before", a->before, "Figures of the reference build")->required()->check(CLI::ExistingFile);
+  cmd->add_option("after", a->after, "Figures of the build to judge")->required()->check(CLI::ExistingFile);
+  cmd->add_option("--tolerance", a->tolerance_pct, "Change in % beyond which a worse figure is a regression (default 10)")
+      ->check(CLI::NonNegativeNumber);
+  cmd->callback([a] {
+    const auto changes = adit::pipeline::compareFigures(adit::pipeline::readBenchFigures(a->before),
+                                                        adit::pipeline::readBenchFigures(a->after), a->tolerance_pct);
+    int regressions = 0;
+    for (const auto& c : changes) {
+      if (c.missing) {
+        fmt::print("  {:<32} only in {}\n", c.name, c.before == 0 && c.after != 0 ? a->after : a->before);
+        continue;
+      }
+      regressions += c.regression ? 1 : 0;
+      fmt::print("  {:<32} {:>10.2f} -> {:>10.2f} {:<3} {:>+7.1f} %{}\n", c.name, c.before, c.after, c.unit, c.change_pct,
+                 c.regression ? "  REGRESSION" : "");
+    }
+    fmt::print("{} regression(s) beyond {:.0f} %\n", regressions, a->tolerance_pct);
+    if (regressions > 0) throw CLI::RuntimeError(1);
   });
 }
 
@@ -132,4 +176,5 @@ void registerBenchCommand(CLI::App& app) {
   bench->require_subcommand(1);
   registerAblation(*bench);
   registerPipelineBench(*bench);
+  registerCompare(*bench);
 }

@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <random>
@@ -85,6 +86,7 @@ LoopCloserConfig testConfig() {
 struct Drive {
   LoopCloser closer{testConfig()};
   int false_loops = 0;
+  std::vector<std::pair<int, int>> applied;  // (sweep at which a loop was applied, its query keyframe)
 };
 
 void drive(Drive& run, const BoxWorld& world, const std::vector<Eigen::Isometry3d>& truth,
@@ -95,8 +97,13 @@ void drive(Drive& run, const BoxWorld& world, const std::vector<Eigen::Isometry3
     pe.pose = mapped[k];
     LidarScan scan = simulateSweep(world, truth[k], static_cast<std::uint32_t>(k + 1), 450);
     scan.utime = pe.utime;
-    const LoopCloser::Result r = run.closer.process(pe, scan);
+    LoopCloser::Result r = run.closer.process(pe, scan);
+    if (k + 1 == truth.size()) {  // end of input: the jobs still in flight
+      const LoopCloser::Result last = run.closer.finish();
+      r.loops.insert(r.loops.end(), last.loops.begin(), last.loops.end());
+    }
     for (const LoopConstraint& loop : r.loops) {
+      run.applied.emplace_back(static_cast<int>(k), loop.query_index);
       const Eigen::Isometry3d T_true = truth[static_cast<std::size_t>(loop.match_index)].inverse() *
                                        truth[static_cast<std::size_t>(loop.query_index)];
       const double err = (T_true.inverse() * loop.T_match_query).translation().norm();
@@ -134,6 +141,31 @@ TEST(LoopCloser, ClosesADriftingLapAndHalvesTheError) {
   EXPECT_LE(after, 0.5 * before);
   EXPECT_EQ(static_cast<int>(run.closer.keyframes().size()), static_cast<int>(truth.size()));
   EXPECT_GT(run.closer.correctedMap(0.5).size(), 1000u);
+}
+
+// Verification and optimisation run on a worker; their outcome is applied loop.apply_delay_s of sensor time
+// after the keyframe, whether the worker is a thread or runs inline: the same loops at the same sweeps, the
+// same graph to the bit.
+TEST(LoopCloser, AppliesLoopJobsAtAFixedLaterSweepWhateverTheThread) {
+  const BoxWorld world = blockLoop();
+  const auto truth = lapPoses(140 + 25);
+  const auto mapped = drifted(truth, 0.02 * kDeg);
+  LoopCloserConfig threaded = testConfig(), inline_jobs = testConfig();
+  threaded.apply_delay_s = inline_jobs.apply_delay_s = 3.0;  // 3 sweeps of 1 s
+  inline_jobs.worker_thread = false;
+  Drive a{LoopCloser{threaded}}, b{LoopCloser{inline_jobs}};
+  drive(a, world, truth, mapped);
+  drive(b, world, truth, mapped);
+  ASSERT_FALSE(a.applied.empty());
+  EXPECT_EQ(a.applied, b.applied);
+  EXPECT_EQ(a.closer.saveState(), b.closer.saveState());
+  // A loop is applied 3 s after the keyframe whose job accepted it; a pending loop that joins it is older.
+  // (Those still in flight at the end of the input are applied by finish(), at the last sweep.)
+  const int last = static_cast<int>(truth.size()) - 1;
+  for (const auto& [sweep, query] : a.applied)
+    if (sweep < last) EXPECT_GE(sweep, query + 3) << "applied 3 s after its keyframe";
+  EXPECT_TRUE(std::any_of(a.applied.begin(), a.applied.end(), [](const auto& x) { return x.first == x.second + 3; }));
+  EXPECT_EQ(a.false_loops, 0);
 }
 
 TEST(LoopCloser, RejectsAPeriodicRoadway) {

@@ -1,0 +1,209 @@
+#include "loop/loop_job.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <memory>
+
+namespace adit {
+namespace {
+
+Eigen::Isometry3d rotationOnly(const Eigen::Matrix3d& R) {
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = R;
+  return T;
+}
+
+Matrix6d loopCovariance(const LoopCloserConfig& config) {
+  const double vt = config.loop_translation_sigma * config.loop_translation_sigma;
+  const double vr = config.loop_rotation_sigma * config.loop_rotation_sigma;
+  Matrix6d c = Matrix6d::Zero();
+  c.diagonal() << vt, vt, vt, vr, vr, vr;
+  return c;
+}
+
+// What a job decides with: its snapshot, the book and the configuration.
+class JobRun {
+ public:
+  JobRun(const LoopJob& job, LoopBook& book, const LoopCloserConfig& config)
+      : job_(job), book_(book), config_(config) {}
+
+  LoopJobOutcome run() {
+    LoopJobOutcome out;
+    out.query = job_.query;
+    if (job_.query - book_.last_loop_query >= config_.cooldown_keyframes) {
+      ++counts_.queries;
+      out.loops = detect();
+    }
+    if (!out.loops.empty()) optimize(out);
+    counts_.pending = static_cast<int>(book_.pending.size());
+    out.book = book_;
+    out.counts = counts_;
+    return out;
+  }
+
+ private:
+  std::vector<LoopConstraint> detect() {
+    for (const LoopCandidateSnapshot& c : job_.candidates) {
+      ++counts_.candidates;
+      const std::optional<LoopConstraint> loop = verify(c);
+      if (!loop) continue;
+      std::vector<LoopConstraint> accepted = admit(*loop);
+      if (!accepted.empty()) {
+        book_.last_loop_query = job_.query;
+        counts_.accepted += static_cast<int>(accepted.size());
+        book_.accepted.insert(book_.accepted.end(), accepted.begin(), accepted.end());
+      }
+      return accepted;  // one verified loop per keyframe is enough
+    }
+    return {};
+  }
+
+  std::optional<LoopConstraint> verify(const LoopCandidateSnapshot& c) {
+    std::vector<SubmapPiece> pieces;
+    for (std::size_t i = 0; i < c.clouds.size(); ++i) pieces.push_back({&c.clouds[i], c.T_match_cloud[i]});
+    const std::vector<Eigen::Vector3f> submap = buildSubmap(pieces, config_.verifier.submap_voxel);
+
+    // Seeds: the Scan Context yaw at zero offset (levelled frames: query = Rz(yaw) * match), then the graph's
+    // current relative pose.
+    const int m = c.candidate.index;
+    Eigen::Matrix3d L_q = Eigen::Matrix3d::Identity(), L_m = Eigen::Matrix3d::Identity();
+    if (config_.level_scan_context) {
+      L_q = levellingRotation(job_.query_uncorrected);
+      L_m = levellingRotation(c.match_uncorrected);
+    }
+    const Eigen::Matrix3d R_yaw = Eigen::AngleAxisd(-c.candidate.yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    const Eigen::Isometry3d T_graph = job_.graph.pose(m).inverse() * job_.graph.pose(job_.query);
+    const std::vector<Eigen::Isometry3d> seeds{rotationOnly(L_m.transpose() * R_yaw * L_q), T_graph};
+
+    const LoopVerification v = verifyLoop(job_.query_cloud, submap, seeds, config_.verifier);
+    if (v.verdict == LoopVerdict::kDegenerate) {
+      ++counts_.rejected_degenerate;
+      return std::nullopt;
+    }
+    if (v.verdict != LoopVerdict::kAccepted) {
+      ++counts_.rejected_fitness;
+      return std::nullopt;
+    }
+    const Matrix6d loop_cov = loopCovariance(config_);
+    const double chi2 = loopChi2(v.T_match_query, T_graph, job_.chain.covarianceBetween(m, job_.query), loop_cov);
+    if (!(chi2 <= config_.max_odometry_chi2)) {
+      ++counts_.rejected_odometry;
+      return std::nullopt;
+    }
+    LoopConstraint loop;
+    loop.query_index = job_.query;
+    loop.match_index = m;
+    loop.query_utime = job_.query_utime;
+    loop.match_utime = c.match_utime;
+    loop.T_match_query = v.T_match_query;
+    loop.information = loop_cov.inverse();
+    loop.scan_context_distance = c.candidate.distance;
+    loop.scan_context_yaw = c.candidate.yaw;
+    loop.fitness = v.icp.rms;
+    loop.inlier_ratio = v.icp.inlier_ratio;
+    return loop;
+  }
+
+  bool pairConsistent(const LoopConstraint& a, const LoopConstraint& b) const {
+    const auto chain = [this](int i, int j) {
+      return i <= j ? job_.chain.covarianceBetween(i, j) : job_.chain.covarianceBetween(j, i);
+    };
+    const Matrix6d cov =
+        chain(a.query_index, b.query_index) + chain(a.match_index, b.match_index) + 2.0 * loopCovariance(config_);
+    const PoseGraph& g = job_.graph;
+    const Eigen::Isometry3d T_ma_mb = g.pose(a.match_index).inverse() * g.pose(b.match_index);
+    const Eigen::Isometry3d T_qa_qb = g.pose(a.query_index).inverse() * g.pose(b.query_index);
+    return pairChi2(a.T_match_query, b.T_match_query, T_ma_mb, T_qa_qb, cov) <= config_.max_pair_chi2;
+  }
+
+  // Decides whether a verified loop joins the graph now, waits for a consistent partner, or is rejected.
+  std::vector<LoopConstraint> admit(const LoopConstraint& loop) {
+    const auto near = [this, &loop](const LoopConstraint& other) {
+      return std::abs(other.query_index - loop.query_index) <= config_.consistency_window;
+    };
+    bool any_near_accepted = false, consistent_with_accepted = false;
+    for (const LoopConstraint& a : book_.accepted) {
+      if (!near(a)) continue;
+      any_near_accepted = true;
+      consistent_with_accepted = consistent_with_accepted || pairConsistent(a, loop);
+    }
+    if (any_near_accepted) {
+      if (consistent_with_accepted) return {loop};
+      ++counts_.rejected_pairwise;
+      return {};
+    }
+    if (config_.min_consistent_loops <= 1) return {loop};
+
+    auto& pending = book_.pending;
+    pending.erase(std::remove_if(pending.begin(), pending.end(), [&](const LoopConstraint& p) { return !near(p); }),
+                  pending.end());
+    std::vector<LoopConstraint> group;
+    std::vector<LoopConstraint> rest;
+    for (const LoopConstraint& p : pending) (pairConsistent(p, loop) ? group : rest).push_back(p);
+    if (static_cast<int>(group.size()) + 1 >= config_.min_consistent_loops) {
+      group.push_back(loop);
+      pending = rest;
+      return group;
+    }
+    pending.push_back(loop);
+    return {};
+  }
+
+  // The snapshot's graph with every accepted loop the main thread had not applied yet (this job's and those
+  // of earlier jobs still in flight), optimised.
+  void optimize(LoopJobOutcome& out) {
+    PoseGraph graph = job_.graph;
+    for (std::size_t i = job_.applied_loops; i < book_.accepted.size(); ++i) {
+      const LoopConstraint& loop = book_.accepted[i];
+      graph.addLoopEdge(loop.match_index, loop.query_index, loop.T_match_query, loop.information);
+    }
+    graph.optimize(config_.graph);
+    ++counts_.optimizations;
+    out.optimized = true;
+    out.poses = graph.poses();
+  }
+
+  const LoopJob& job_;
+  LoopBook& book_;
+  const LoopCloserConfig& config_;
+  LoopCloserStats counts_;
+};
+
+}  // namespace
+
+Eigen::Matrix3d levellingRotation(const Eigen::Isometry3d& T_world_lidar) {
+  const Eigen::Matrix3d R = T_world_lidar.linear();
+  const double yaw = std::atan2(R(1, 0), R(0, 0));
+  return Eigen::AngleAxisd(-yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix() * R;
+}
+
+LoopJobOutcome runLoopJob(const LoopJob& job, LoopBook& book, const LoopCloserConfig& config) {
+  return JobRun(job, book, config).run();
+}
+
+LoopScheduler::LoopScheduler(const LoopCloserConfig& config, const LoopBook& book)
+    : config_(config), book_(book), worker_(config.worker_thread) {}
+
+void LoopScheduler::submit(LoopJob job, std::int64_t due_utime) {
+  auto task = std::make_shared<std::packaged_task<LoopJobOutcome()>>(
+      [this, job = std::move(job)] { return runLoopJob(job, book_, config_); });
+  pending_.push_back({due_utime, task->get_future()});
+  worker_.post([task] { (*task)(); });
+}
+
+std::vector<LoopJobOutcome> LoopScheduler::take(std::int64_t utime, bool all) {
+  std::vector<LoopJobOutcome> due;
+  while (!pending_.empty() && (all || pending_.front().due_utime <= utime)) {
+    std::future<LoopJobOutcome>& f = pending_.front().outcome;
+    // Wall clock for STATUS only: how long the sweep stream waited for the worker.
+    const auto start = std::chrono::steady_clock::now();
+    f.wait();
+    waited_ms_ += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    due.push_back(f.get());
+    pending_.pop_front();
+  }
+  return due;
+}
+
+}  // namespace adit

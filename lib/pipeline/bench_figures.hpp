@@ -1,0 +1,36 @@
+// The figures of `adit bench pipeline` as named numbers, written to and read from JSON, and the comparison
+// of two runs (`adit bench compare a.json b.json`): one line per figure with its change, regressions flagged.
+#pragma once
+
+#include "pipeline/replay.hpp"
+
+#include <string>
+#include <vector>
+
+namespace adit::pipeline {
+
+struct BenchFigure {
+  std::string name;  // "feature.cpu_median_ms", "wall_ms_per_sweep", ...
+  double value = 0;
+  std::string unit;
+  bool higher_is_better = false;  // realtime_factor; every time and memory figure is better lower
+};
+
+std::vector<BenchFigure> benchFigures(const ReplayReport& report);
+// {"input": ..., "figures": [{"name", "value", "unit", "higher_is_better"}, ...]}
+std::string benchFiguresJson(const std::vector<BenchFigure>& figures, const std::string& input);
+// Throws std::runtime_error naming the file when it cannot be read or is not such a JSON file.
+std::vector<BenchFigure> readBenchFigures(const std::string& path);
+
+struct FigureChange {
+  std::string name, unit;
+  double before = 0, after = 0;
+  double change_pct = 0;    // (after - before) / before
+  bool regression = false;  // worse by more than the tolerance
+  bool missing = false;     // only in one of the two files
+};
+
+std::vector<FigureChange> compareFigures(const std::vector<BenchFigure>& before, const std::vector<BenchFigure>& after,
+                                         double tolerance_pct);
+
+}  // namespace adit::pipeline
