@@ -67,11 +67,10 @@ struct Target {
 template <class Msg>
 int typeOf() { return msg::wire::TypeIndex<Msg>::value; }
 
-// Bounds on how far the pose of the clean last quarter may differ from the run without mutations. The
-// odometry integrates: a mutated sweep it accepts (points moved by a flipped bit, an extra sweep at an
-// intermediate time) is registered like any other, and its error stays in the trajectory; the mapper
-// re-registers against its map, so its error stays smaller. 0.5 m is 1 % of the ~50 m such a 60 s run drives,
-// the project's drift figure, and far below a jump that would ghost the map (a roadway is 4-5 m wide).
+// Bound on how far the pose of the clean last quarter may differ from the run fed the unmutated copies. The
+// odometry integrates: a mutated sweep it uses (points moved by a flipped bit) is registered like any other
+// and its error stays in the trajectory; the mapper re-registers against its map. 0.5 m is a tenth of a
+// roadway's width (4-5 m): a map drawn from poses that far apart still shows one roadway, not two.
 std::vector<Target> targets() {
   return {
       {"feature", "LIDAR_POINTS", "LIDAR_POINTS (lidar_scan_t, compact)", typeOf<adit::lidar_scan_t>(), false, "", 0},
