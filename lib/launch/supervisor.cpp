@@ -232,7 +232,9 @@ int supervise(const LaunchSpec& spec, const SupervisorOptions& options) {
   if (!spec.record_channels.empty()) {
     Child rec;
     // -f is never given: the path is always new (nextRecordPath), and lcm-logger refuses to overwrite.
-    rec.spec = {"recorder", {"lcm-logger", "-q", "-c", spec.record_channels, "record.lcmlog"}, Restart::OnFailure};
+    rec.spec.name = "recorder";
+    rec.spec.command = {"lcm-logger", "-q", "-c", spec.record_channels, "record.lcmlog"};
+    rec.spec.restart = Restart::OnFailure;
     rec.policy = RestartPolicy(spec.recorder_limits);
     rec.recorder = true;
     children.push_back(std::move(rec));

@@ -153,7 +153,7 @@ TEST(LoopCloser, AppliesLoopJobsAtAFixedLaterSweepWhateverTheThread) {
   LoopCloserConfig threaded = testConfig(), inline_jobs = testConfig();
   threaded.apply_delay_s = inline_jobs.apply_delay_s = 3.0;  // 3 sweeps of 1 s
   inline_jobs.worker_thread = false;
-  Drive a{LoopCloser{threaded}}, b{LoopCloser{inline_jobs}};
+  Drive a{LoopCloser{threaded}, 0, {}}, b{LoopCloser{inline_jobs}, 0, {}};
   drive(a, world, truth, mapped);
   drive(b, world, truth, mapped);
   ASSERT_FALSE(a.applied.empty());
@@ -162,8 +162,11 @@ TEST(LoopCloser, AppliesLoopJobsAtAFixedLaterSweepWhateverTheThread) {
   // A loop is applied 3 s after the keyframe whose job accepted it; a pending loop that joins it is older.
   // (Those still in flight at the end of the input are applied by finish(), at the last sweep.)
   const int last = static_cast<int>(truth.size()) - 1;
-  for (const auto& [sweep, query] : a.applied)
-    if (sweep < last) EXPECT_GE(sweep, query + 3) << "applied 3 s after its keyframe";
+  for (const auto& [sweep, query] : a.applied) {
+    if (sweep < last) {
+      EXPECT_GE(sweep, query + 3) << "applied 3 s after its keyframe";
+    }
+  }
   EXPECT_TRUE(std::any_of(a.applied.begin(), a.applied.end(), [](const auto& x) { return x.first == x.second + 3; }));
   EXPECT_EQ(a.false_loops, 0);
 }
