@@ -93,9 +93,20 @@ bool Node::valuesOk(const std::string& port, const msg::Validation& invalid) {
   return false;
 }
 
+std::int64_t Node::Input::typicalStep() const {
+  if (recent_steps.size() < 3) return 0;
+  std::vector<std::int64_t> sorted = recent_steps;
+  std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
+  return sorted[sorted.size() / 2];
+}
+
 bool Node::continuesStream(const Input& input, std::int64_t utime) const {
   const auto tolerance = static_cast<std::int64_t>(checks_.max_future_s * 1e6);
   if (input.last_utime >= 0 && utime <= input.last_utime) return false;
+  if (input.kind == InputKind::Stream && input.last_utime >= 0) {
+    const std::int64_t period = input.typicalStep();
+    if (period > 0 && static_cast<double>(utime - input.last_utime) > checks_.max_step_periods * period) return false;
+  }
   return newest_utime_ < 0 || utime <= newest_utime_ + tolerance;
 }
 
@@ -158,6 +169,11 @@ void Node::accept(Input& input, Held& message) {
       spdlog::warn("[{}] {}: time jumps forward by {:.3f} s: resetting temporal state", name_,
                    channels_.at(input.port), static_cast<double>(utime - input.last_utime) * 1e-6);
       onTimeJump(input.port);
+    }
+    if (input.kind == InputKind::Stream && input.last_utime >= 0 && utime > input.last_utime) {
+      constexpr std::size_t kSteps = 7;
+      if (input.recent_steps.size() == kSteps) input.recent_steps.erase(input.recent_steps.begin());
+      input.recent_steps.push_back(utime - input.last_utime);
     }
     input.last_utime = utime;
     if (input.kind == InputKind::Stream) newest_utime_ = std::max(newest_utime_, utime);

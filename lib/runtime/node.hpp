@@ -49,6 +49,12 @@ struct InputChecks {
   // isolated backwards stamp is dropped as time_backwards.
   double max_future_s = 2.0;
   int confirm_messages = 2;
+  // On a Stream, a step forward of more than this many of the stream's typical periods (the median of its
+  // last steps) needs the same confirmation, even when it is within max_future_s: one message stamped 1 s
+  // ahead would otherwise be adopted, and the valid messages of that second dropped as going backwards (the
+  // mutation campaign moved the odometry 18.8 km that way). A real gap (lost messages, a stall) only delays
+  // the first messages after it by confirm_messages.
+  double max_step_periods = 4.0;
   // A sequence-number gap larger than this (or a number that goes back) is a restarted or forged publisher,
   // counted once as seq_reset, not as that many lost messages.
   std::int64_t max_seq_gap = 10000;
@@ -144,6 +150,8 @@ class Node {
     std::int64_t last_utime = -1;
     std::int64_t last_seq = -1;
     std::vector<Held> held;  // messages that do not continue the stream's time, oldest first
+    std::vector<std::int64_t> recent_steps;  // last accepted forward steps (us), oldest first
+    std::int64_t typicalStep() const;        // their median; 0 until a few are known
   };
   // Steps 1 and 3 of the input checks; false (counted) when the message must be skipped.
   bool wireOk(const std::string& port, const msg::WireCheck& check, std::size_t size);

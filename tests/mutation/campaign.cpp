@@ -58,9 +58,10 @@ struct Target {
   bool full_sweeps = false;  // LIDAR_POINTS as point_cloud_t
   std::string pose_channel;  // output carrying the node's pose estimate ("" = none)
   double pose_bound_m = 0;
-  // Known open defect (README): a stamp up to 2 s ahead is adopted at once, the valid messages of those 2 s are
-  // dropped as time_backwards and the odometry loses track. Stamp mutations of this channel run as a separate
-  // pass whose pose is reported, not asserted.
+  // A single forged stamp ahead is held and dropped (runtime/node.cpp, max_step_periods), but this pass puts
+  // several copies into one gap, and consistent forged stamps in a row look like a real jump of the sensor's
+  // time (only authentication would tell): stamp mutations of this channel run as a separate pass whose pose is
+  // reported, not asserted.
   bool stamps_known_to_move_pose = false;
 };
 

@@ -65,6 +65,29 @@ TEST(InputChecks, OneFutureStampIsDroppedAndDoesNotBlockTheStream) {
   EXPECT_EQ(node.jumps, 0);
 }
 
+// Found by the mutation campaign: a stamp within max_future_s (2 s) but many periods ahead used to be adopted,
+// and the valid messages of the next second dropped as going backwards.
+TEST(InputChecks, AStampManyPeriodsAheadWithinTheFutureLimitIsHeldNotAdopted) {
+  ImuNode node;
+  for (int i = 1; i <= 10; ++i) send(node, imu(i * 5 * kMs));
+  send(node, imu(50 * kMs + 1 * kS));  // forged: 1 s (200 periods) ahead, within max_future_s
+  for (int i = 11; i <= 20; ++i) send(node, imu(i * 5 * kMs));
+  EXPECT_EQ(node.utimes.size(), 20u);
+  EXPECT_EQ(node.utimes.back(), 100 * kMs);
+  EXPECT_EQ(counter(node, "time_future"), 1);
+  EXPECT_EQ(counter(node, "time_backwards"), 0);
+  EXPECT_EQ(node.jumps, 0);
+}
+
+TEST(InputChecks, AShortGapOfLostMessagesIsDelayedNotLost) {
+  ImuNode node;
+  for (int i = 1; i <= 10; ++i) send(node, imu(i * 5 * kMs));
+  for (int i = 21; i <= 25; ++i) send(node, imu(i * 5 * kMs));  // 10 messages lost: held until confirmed
+  EXPECT_EQ(node.utimes.size(), 15u);
+  EXPECT_EQ(node.utimes[10], 105 * kMs);
+  EXPECT_EQ(counter(node, "time_future"), 0);
+}
+
 TEST(InputChecks, ARealStallIsAcceptedAsATimeJumpOnceTheStreamContinues) {
   ImuNode node;
   for (int i = 1; i <= 5; ++i) send(node, imu(i * 5 * kMs));
