@@ -1,6 +1,7 @@
 #include "msg/convert.hpp"
 
 #include "core/geometry.hpp"
+#include "msg/sweep_header.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -77,15 +78,7 @@ std::vector<LidarPoint> pointsFromMessage(const adit::point_cloud_t& m) {
 }
 
 LidarScan fromMessage(const adit::point_cloud_t& m) {
-  LidarScan scan;
-  scan.utime = m.header.utime;
-  scan.seq = m.header.seq;
-  scan.sensor = m.sensor;
-  scan.num_beams = m.num_beams;
-  scan.sweep_duration = m.sweep_duration;
-  scan.has_ring = (m.flags & adit::point_cloud_t::FLAG_HAS_RING) != 0;
-  scan.has_time = (m.flags & adit::point_cloud_t::FLAG_HAS_TIME) != 0;
-  scan.deskewed = (m.flags & adit::point_cloud_t::FLAG_DESKEWED) != 0;
+  LidarScan scan = sweepHeader(m);
   scan.points = pointsFromMessage(m);
   return scan;
 }

@@ -1,6 +1,7 @@
 #include "msg/sweep_codec.hpp"
 
 #include "msg/convert.hpp"
+#include "msg/sweep_header.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -226,19 +227,6 @@ std::string checkCommon(const adit::lidar_scan_t& m) {
   return "";
 }
 
-LidarScan scanHeader(const adit::lidar_scan_t& m) {
-  LidarScan s;
-  s.utime = m.header.utime;
-  s.seq = m.header.seq;
-  s.sensor = m.sensor;
-  s.num_beams = m.num_beams;
-  s.sweep_duration = m.sweep_duration;
-  s.has_ring = (m.flags & adit::point_cloud_t::FLAG_HAS_RING) != 0;
-  s.has_time = (m.flags & adit::point_cloud_t::FLAG_HAS_TIME) != 0;
-  s.deskewed = (m.flags & adit::point_cloud_t::FLAG_DESKEWED) != 0;
-  return s;
-}
-
 std::string decodeGrid(const adit::lidar_scan_t& m, LidarScan& s) {
   const int beams = m.num_beams;
   if (beams <= 0) return "a firing grid without beams";
@@ -331,7 +319,7 @@ adit::lidar_scan_t encodeSweep(const LidarScan& scan, const FiringTable* table) 
 
 std::string decodeSweep(const adit::lidar_scan_t& m, LidarScan& scan) {
   if (std::string e = checkCommon(m); !e.empty()) return e;
-  scan = scanHeader(m);
+  scan = sweepHeader(m);
   if (m.layout == adit::lidar_scan_t::LAYOUT_GRID) return decodeGrid(m, scan);
   if (m.layout == adit::lidar_scan_t::LAYOUT_POINTS) return decodePoints(m, scan);
   return "unknown layout " + std::to_string(m.layout);
