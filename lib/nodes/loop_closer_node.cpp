@@ -211,16 +211,22 @@ class LoopCloserNode : public runtime::Node, public WritesProducts {
 
   std::string keyframesPath() const { return state_.folder().file("loop_closer.keyframes"); }
 
+  // One pose as a row of a message's position (3) and orientation (4) arrays.
+  static void appendPose(const Eigen::Isometry3d& T, std::vector<std::vector<double>>& positions,
+                         std::vector<std::vector<double>>& orientations) {
+    std::vector<double> position(3), orientation(4);
+    splitPose(T, position.data(), orientation.data());
+    positions.push_back(std::move(position));
+    orientations.push_back(std::move(orientation));
+  }
+
   void publishGraph(std::int64_t utime, const LoopCloser::Result& result) {
     adit::pose_graph_t g;
     g.header = msg::makeHeader(utime, "world");
     g.num_nodes = static_cast<std::int32_t>(result.corrected_keyframes.size());
     for (const StampedPose& k : result.corrected_keyframes) {
       g.node_utime.push_back(k.utime);
-      std::vector<double> position(3), orientation(4);
-      splitPose(k.pose, position.data(), orientation.data());
-      g.position.push_back(position);
-      g.orientation.push_back(orientation);
+      appendPose(k.pose, g.position, g.orientation);
     }
     splitPose(result.T_corrected_uncorrected, g.correction_position, g.correction_orientation);
     g.num_loops = static_cast<std::int32_t>(closer_.acceptedLoops().size());
@@ -245,10 +251,7 @@ class LoopCloserNode : public runtime::Node, public WritesProducts {
     m.num_new = static_cast<std::int32_t>(m.new_submaps.size());
     for (const SubmapPose& s : update.moved) {
       m.moved_id.push_back(s.id);
-      std::vector<double> position(3), orientation(4);
-      splitPose(s.pose, position.data(), orientation.data());
-      m.moved_position.push_back(position);
-      m.moved_orientation.push_back(orientation);
+      appendPose(s.pose, m.moved_position, m.moved_orientation);
     }
     m.num_moved = static_cast<std::int32_t>(m.moved_id.size());
     count("map_update_submaps", static_cast<std::int64_t>(update.added.size()));
