@@ -70,6 +70,7 @@ echo "  A adit replay of its log  APE rmse $R_RMSE m, max $R_MAX m"
 echo "  B each stage killed once  APE rmse $B_RMSE m, max $B_MAX m ($(awk -v a="$A_RMSE" -v b="$B_RMSE" 'BEGIN { printf "%+.0f %%", (b / a - 1) * 100 }') vs A)"
 echo "  B restarts:"; grep "^restart" "$OUT/killed/report.txt" | sed 's/^/    /'
 echo "  loops accepted: A $(loops "$OUT/undisturbed/report.txt"), B $(loops "$OUT/killed/report.txt") (B's loop closer was killed before them: they close against recovered keyframes), replay $(awk '$1 == "EDGE_SE3:QUAT" && $3 - $2 > 1' "$OUT/undisturbed/replay/pose_graph.g2o" | wc -l)"
+echo "  $(grep "^latency" "$OUT/undisturbed/report.txt") (A; B: $(grep "^latency" "$OUT/killed/report.txt" | cut -d" " -f3-))"
 echo "  MAP_UPDATE (A): $(grep "^map_update" "$OUT/undisturbed/report.txt")"
 echo "  sweeps reaching the map owner: A $(wc -l < "$RUN_A/trajectory.tum"), B $(wc -l < "$RUN_B/trajectory.tum"), replay $(wc -l < "$OUT/undisturbed/replay/trajectory.tum")"
 echo "  map vs world A live:   $("$BIN/map_vs_world" "$RUN_A/map.pcd" "$OUT/world.pcd" "$OUT/undisturbed/gt.tum" "$RUN_A/trajectory.tum")"
