@@ -11,6 +11,14 @@
 namespace adit {
 namespace {
 
+// T with its rotation part projected back onto a rotation (through a unit quaternion).
+Eigen::Isometry3d orthonormal(const Eigen::Isometry3d& T) {
+  Eigen::Isometry3d out = Eigen::Isometry3d::Identity();
+  out.linear() = Eigen::Quaterniond(T.linear()).normalized().toRotationMatrix();
+  out.translation() = T.translation();
+  return out;
+}
+
 constexpr double kDegToRad = 3.14159265358979323846 / 180.0;
 
 // PoseEstimate's default covariance is identity: a mapper that did not estimate one leaves it so.
@@ -126,9 +134,12 @@ void LoopCloser::applyDue(std::int64_t utime, bool all, Result& result) {
     }
     if (!o.optimized || o.poses.empty()) continue;
     const int held = static_cast<int>(o.poses.size());
-    const Eigen::Isometry3d moved = o.poses.back() * graph_.pose(held - 1).inverse();
+    // Re-orthonormalised: Isometry3d::inverse() transposes, so a rotation a rounding error off orthonormal
+    // passes its scale on through `moved` to every newer node, and the next job's `moved` doubles it. Over a
+    // 30-minute run (hundreds of jobs) POSE_GRAPH quaternions reached norm 1.2 and the mapper refused them.
+    const Eigen::Isometry3d moved = orthonormal(o.poses.back() * orthonormal(graph_.pose(held - 1)).inverse());
     for (int k = 0; k < held; ++k) graph_.setPose(k, o.poses[static_cast<std::size_t>(k)]);
-    for (int k = held; k < graph_.size(); ++k) graph_.setPose(k, moved * graph_.pose(k));
+    for (int k = held; k < graph_.size(); ++k) graph_.setPose(k, orthonormal(moved * graph_.pose(k)));
     result.graph_updated = true;
   }
   if (!result.loops.empty()) result.loop = result.loops.back();
