@@ -12,6 +12,7 @@ using wire::kDims;
 using wire::kMembers;
 using wire::kNumStructs;
 using wire::kStructs;
+using wire::widthOf;
 using wire::MemberSchema;
 using wire::StructSchema;
 
@@ -26,16 +27,6 @@ std::uint64_t computeHash(int index, std::vector<int>& parents) {
     if (kMembers[m].kind == Kind::Struct) hash += computeHash(kMembers[m].nested, parents);
   parents.pop_back();
   return (hash << 1) + ((hash >> 63) & 1);
-}
-
-std::size_t widthOf(Kind kind) {
-  switch (kind) {
-    case Kind::Int8: return 1;
-    case Kind::Int16: return 2;
-    case Kind::Int32: case Kind::Float: return 4;
-    case Kind::Int64: case Kind::Double: return 8;
-    default: return 0;  // variable size
-  }
 }
 
 class Walker {

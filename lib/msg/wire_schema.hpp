@@ -3,6 +3,7 @@
 // what they hold. lib/msg/wire_check.hpp walks them.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 
 namespace adit::msg::wire {
@@ -10,6 +11,17 @@ namespace adit::msg::wire {
 // How a member is encoded: big-endian integers and IEEE floats of the given width, a string
 // (int32 length including the terminating NUL, then the bytes), or a nested struct (without its hash).
 enum class Kind : std::uint8_t { Int8, Int16, Int32, Int64, Float, Double, String, Struct };
+
+// Bytes of one value of a fixed-width kind; 0 for strings and structs (variable size).
+constexpr std::size_t widthOf(Kind kind) {
+  switch (kind) {
+    case Kind::Int8: return 1;
+    case Kind::Int16: return 2;
+    case Kind::Int32: case Kind::Float: return 4;
+    case Kind::Int64: case Kind::Double: return 8;
+    default: return 0;
+  }
+}
 
 struct DimSchema {
   std::int32_t fixed;   // the size when fixed, -1 when it is read from a member

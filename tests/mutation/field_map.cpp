@@ -7,16 +7,7 @@ using msg::wire::Kind;
 using msg::wire::kDims;
 using msg::wire::kMembers;
 using msg::wire::kStructs;
-
-std::size_t widthOf(Kind kind) {
-  switch (kind) {
-    case Kind::Int8: return 1;
-    case Kind::Int16: return 2;
-    case Kind::Int32: case Kind::Float: return 4;
-    case Kind::Int64: case Kind::Double: return 8;
-    default: return 0;
-  }
-}
+using msg::wire::widthOf;
 
 class Mapper {
  public:
