@@ -181,7 +181,11 @@ Validation validate(const adit::pose_graph_t& m, const InputLimits& limits) {
 }
 
 Validation validate(const adit::command_t& m, const InputLimits& limits) {
-  return Check(limits).merge(validate(m.header, limits)).text("command", m.command).text("argument", m.argument).result();
+  Check c(limits);
+  c.merge(validate(m.header, limits)).text("command", m.command).text("argument", m.argument);
+  // A signature is an HMAC-SHA256 (32 bytes) or absent; any other size is not one.
+  c.count("mac_size", (m.mac_size == 0 || m.mac_size == 32) && m.mac.size() == static_cast<std::size_t>(m.mac_size));
+  return c.result();
 }
 
 Validation validate(const adit::status_t& m, const InputLimits& limits) {

@@ -25,14 +25,6 @@ namespace {
 
 constexpr const char* kKeyframesKind = "loop_closer_keyframes";
 
-// What a command said, fit for one log line: at most 80 characters, anything unprintable as '?'.
-std::string printable(const std::string& text) {
-  std::string out = text.substr(0, 80);
-  for (char& c : out)
-    if (c < 0x20 || c > 0x7e) c = '?';
-  return text.size() > 80 ? out + "..." : out;
-}
-
 // The loop closer owns the corrected map of a run: its keyframes are the submaps (each keyframe's cloud
 // anchored to the keyframe), the pose graph places them. It answers save_map, publishes MAP_UPDATE for
 // viewers, and checkpoints keyframes and graph so that a restart keeps what was mapped before it.
@@ -121,14 +113,15 @@ class LoopCloserNode : public runtime::Node, public WritesProducts {
   // (default map.pcd, trajectory.tum, pose_graph.g2o). NAME must be a plain file name: a command comes from
   // anyone on the bus, and must not choose where the process writes.
   void onCommand(const adit::command_t& m) {
+    if (!commandAuthentic("command", m)) return;
     if (m.command != "save_map") {
-      reportError("unknown_command", "unknown command '" + printable(m.command) + "' (known: save_map)");
+      reportError("unknown_command", "unknown command '" + runtime::printableText(m.command) + "' (known: save_map)");
       return;
     }
     if (!m.argument.empty()) {
       const std::string problem = runtime::plainFileNameProblem(m.argument);
       if (!problem.empty()) {
-        reportError("command_refused", "save_map '" + printable(m.argument) + "' refused: " + problem +
+        reportError("command_refused", "save_map '" + runtime::printableText(m.argument) + "' refused: " + problem +
                                            " (files go into the run folder " + state_.folder().dir + ")");
         return;
       }

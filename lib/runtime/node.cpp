@@ -1,5 +1,7 @@
 #include "runtime/node.hpp"
 
+#include <adit/command_t.hpp>
+
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
@@ -207,6 +209,20 @@ void Node::emit(const std::string& port, Bytes bytes, std::int64_t utime) {
   if (!sink_) throw std::logic_error(name_ + ": publish outside deliver()/finish()");
   ++health_.outputs;
   sink_->publish(channels_.at(port), bytes, utime);
+}
+
+void Node::requireSignedCommands(CommandKey key) { command_gate_ = std::make_unique<CommandGate>(std::move(key)); }
+
+bool Node::commandAuthentic(const std::string& port, const adit::command_t& command) {
+  if (!command_gate_) return true;
+  const std::int64_t now = std::chrono::duration_cast<std::chrono::microseconds>(
+                               std::chrono::system_clock::now().time_since_epoch()).count();
+  const CommandVerdict verdict = command_gate_->check(channels_.at(port), command.command, command.argument,
+                                                      command.counter, command.mac, now);
+  if (verdict == CommandVerdict::Authentic) return true;
+  reportError(counterName(verdict), "command '" + printableText(command.command) + "' on " + channels_.at(port) +
+                                        " refused: " + describe(verdict));
+  return false;
 }
 
 void Node::reportError(const std::string& counter, const std::string& message) {

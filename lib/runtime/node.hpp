@@ -15,6 +15,7 @@
 #include "msg/encode.hpp"
 #include "msg/validate.hpp"
 #include "msg/wire_check.hpp"
+#include "runtime/command_auth.hpp"
 #include "runtime/health.hpp"
 #include "runtime/run_folder.hpp"
 
@@ -24,6 +25,10 @@
 #include <memory>
 #include <string>
 #include <vector>
+
+namespace adit {
+class command_t;
+}
 
 namespace adit::runtime {
 
@@ -112,6 +117,9 @@ class Node {
   void setMaxTimeGap(double seconds) { max_time_gap_us_ = static_cast<std::int64_t>(seconds * 1e6); }
   void setInputChecks(const InputChecks& checks) { checks_ = checks; }
   const InputChecks& inputChecks() const { return checks_; }
+  // From now on obey only commands signed with this key (runtime/command_auth.hpp); a live process's
+  // --command-key. Without a key every well-formed command is obeyed (replay, tests, a private bus).
+  void requireSignedCommands(CommandKey key);
 
  protected:
   // Declare an input port. Handler is called with the decoded message, in arrival order.
@@ -134,6 +142,10 @@ class Node {
 
   // Called after a forward time gap on `port`, before the message is handled: reset temporal state.
   virtual void onTimeJump(const std::string& /*port*/) {}
+  // True when a command that arrived on `port` may be obeyed: always without a key, else only when signed
+  // (a refusal is counted as command_unsigned / command_bad_mac / command_replayed / command_stale). The
+  // clock window is the one wall-clock read of a node, and only with a key, which replay never has.
+  bool commandAuthentic(const std::string& port, const adit::command_t& command);
   virtual void onFinish() {}
 
  private:
@@ -179,6 +191,7 @@ class Node {
   InputChecks checks_;
   std::int64_t newest_utime_ = -1;                 // newest accepted stamp on any Stream input (the sensor clock)
   std::map<std::string, std::int64_t> bursts_;     // counter -> repeats not logged yet
+  std::unique_ptr<CommandGate> command_gate_;      // set when commands must be signed
 };
 
 template <class Msg>

@@ -9,6 +9,7 @@
 
 #include <chrono>
 #include <csignal>
+#include <cstdlib>
 
 namespace adit::runtime {
 namespace {
@@ -71,6 +72,15 @@ void addProcessOptions(CLI::App& app, ProcessOptions& o) {
   app.add_option("--run-dir", o.run_dir,
                  "Run folder for the files commands ask for and for checkpoints (default: $ADIT_RUN_DIR, else .)");
   app.add_option("--status-channel", o.status_channel, "STATUS channel (default STATUS_<process>)");
+  app.add_option("--command-key", o.command_key,
+                 "Obey only commands signed with this key file (`adit command keygen`; default: $ADIT_COMMAND_KEY, "
+                 "else commands are not signed)");
+}
+
+std::string commandKeyPath(const std::string& flag_path) {
+  if (!flag_path.empty()) return flag_path;
+  const char* env = std::getenv("ADIT_COMMAND_KEY");
+  return env ? std::string(env) : std::string();
 }
 
 Config loadConfig(const std::vector<std::string>& paths) {
@@ -107,6 +117,12 @@ int runNodeProcess(int argc, char** argv, const std::string& name, const std::st
     node = factory(loadConfig(options.config_paths));
     applyRemaps(*node, options.channel_remaps);
     node->useRunFolder(liveRunFolder(options.run_dir));
+    // An unreadable key stops the process: the operator asked for signed commands, so obeying anyone is wrong.
+    const std::string key_path = commandKeyPath(options.command_key);
+    if (!key_path.empty()) {
+      node->requireSignedCommands(readCommandKey(key_path));
+      spdlog::info("commands must be signed with the key in {}", key_path);
+    }
   } catch (const std::exception& e) {
     spdlog::error("{}", e.what());
     return 2;

@@ -24,7 +24,11 @@ struct ProcessOptions {
   double status_period_s = 1.0;
   std::string status_channel;  // "" = STATUS_<NAME>
   std::string run_dir;  // "" = $ADIT_RUN_DIR, else "." (runtime/run_folder.hpp)
+  std::string command_key;  // "" = $ADIT_COMMAND_KEY, else commands need no signature
 };
+
+// The command key file a process uses: flag_path, else $ADIT_COMMAND_KEY, else "" (none).
+std::string commandKeyPath(const std::string& flag_path);
 
 void addProcessOptions(CLI::App& app, ProcessOptions& options);
 

@@ -1,15 +1,18 @@
 // adit command save_map [NAME]: asks the running map owner (the loop closer) to save the corrected map,
 // trajectory and pose graph into its run folder, as NAME.pcd / NAME.tum / NAME.g2o (default map.pcd,
 // trajectory.tum, pose_graph.g2o). The receiver checks the name again: anyone on the bus can publish.
+// With a key (--key / $ADIT_COMMAND_KEY) the command is signed, for processes that obey only signed ones.
+// adit command keygen FILE: writes a new random key (mode 0600, never over an existing file).
 #include "commands.hpp"
 #include "msg/encode.hpp"
+#include "runtime/command_auth.hpp"
+#include "runtime/process.hpp"
 #include "runtime/run_folder.hpp"
 
 #include <adit/command_t.hpp>
 #include <lcm/lcm-cpp.hpp>
 #include <spdlog/spdlog.h>
 
-#include <chrono>
 #include <stdexcept>
 #include <vector>
 
@@ -19,7 +22,19 @@ struct CommandArgs {
   std::string name;
   std::string lcm_url;
   std::string channel = "MAPPER_COMMAND";
+  std::string key_path;
+  std::string new_key_path;
 };
+
+// Signs with the sender's wall clock as the counter: the receiver accepts it within its clock window and
+// only above the last counter it accepted.
+void sign(adit::command_t& c, const std::string& channel, const std::string& key_path) {
+  const adit::runtime::CommandKey key = adit::runtime::readCommandKey(key_path);
+  c.counter = adit::runtime::wallUtime();
+  const adit::runtime::CommandMac mac = adit::runtime::commandMac(key, channel, c.command, c.argument, c.counter);
+  c.mac.assign(mac.begin(), mac.end());
+  c.mac_size = static_cast<std::int32_t>(c.mac.size());
+}
 
 void publishSaveMap(const CommandArgs& a) {
   if (!a.name.empty()) {
@@ -28,27 +43,37 @@ void publishSaveMap(const CommandArgs& a) {
   }
   lcm::LCM lcm(a.lcm_url);
   if (!lcm.good()) throw std::runtime_error("cannot open LCM '" + a.lcm_url + "'");
-  adit::command_t c;
-  c.header.utime = std::chrono::duration_cast<std::chrono::microseconds>(
-                       std::chrono::system_clock::now().time_since_epoch()).count();
+  adit::command_t c{};
+  c.header.utime = adit::runtime::wallUtime();
   c.header.seq = 0;
   c.command = "save_map";
   c.argument = a.name;
+  const std::string key_path = adit::runtime::commandKeyPath(a.key_path);
+  if (!key_path.empty()) sign(c, a.channel, key_path);
   const std::vector<std::uint8_t> bytes = adit::msg::encode(c);
   if (lcm.publish(a.channel, bytes.data(), static_cast<unsigned int>(bytes.size())) != 0)
     throw std::runtime_error("cannot publish on " + a.channel);
-  spdlog::info("sent save_map{} on {}", a.name.empty() ? "" : " " + a.name, a.channel);
+  spdlog::info("sent {}save_map{} on {}", key_path.empty() ? "" : "signed ", a.name.empty() ? "" : " " + a.name,
+               a.channel);
 }
 
 }  // namespace
 
 void registerCommandCommand(CLI::App& app) {
   auto a = std::make_shared<CommandArgs>();
-  auto* cmd = app.add_subcommand("command", "Send a command to the running processes (save_map [NAME])");
+  auto* cmd = app.add_subcommand("command", "Send a command to the running processes (save_map [NAME]), or make a key");
   cmd->require_subcommand(1);
   auto* save = cmd->add_subcommand("save_map", "The map owner saves the corrected map, trajectory and pose graph into its run folder");
   save->add_option("name", a->name, "Plain file name (NAME.pcd, NAME.tum, NAME.g2o); default map.pcd, trajectory.tum, pose_graph.g2o");
   save->add_option("--lcm-url", a->lcm_url, "LCM provider (default: $LCM_DEFAULT_URL or udpm)");
   save->add_option("--channel", a->channel, "Command channel")->capture_default_str();
+  save->add_option("--key", a->key_path, "Sign with this key file (default: $ADIT_COMMAND_KEY, else unsigned)");
   save->callback([a] { publishSaveMap(*a); });
+  auto* keygen = cmd->add_subcommand("keygen", "Write a new random command key (hex, mode 0600) to FILE; never overwrites");
+  keygen->add_option("file", a->new_key_path, "Where to write the key")->required();
+  keygen->callback([a] {
+    adit::runtime::writeNewCommandKey(a->new_key_path);
+    spdlog::info("wrote a new command key to {} (give it to the processes with --command-key or $ADIT_COMMAND_KEY)",
+                 a->new_key_path);
+  });
 }

@@ -2,6 +2,8 @@
 // anything else is refused, counted and logged, and nothing is written.
 #include "node_harness.hpp"
 #include "nodes/registry.hpp"
+#include "runtime/command_auth.hpp"
+#include "runtime/process.hpp"
 #include "runtime/run_folder.hpp"
 
 #include <adit/command_t.hpp>
@@ -13,7 +15,7 @@ using adit::test::counter;
 namespace {
 
 adit::command_t command(const std::string& name, const std::string& argument) {
-  adit::command_t c;
+  adit::command_t c{};
   c.header.utime = 0;
   c.header.seq = 0;
   c.command = name;
@@ -68,6 +70,51 @@ TEST(Commands, HostilePathsAreRefusedAndCounted) {
   EXPECT_NE(node->health().last_error.find("refused"), std::string::npos);
   adit::test::deliver(*node, "MAPPER_COMMAND", command("rm", "-rf /"), sink);
   EXPECT_EQ(counter(*node, "unknown_command"), 1);
+}
+
+adit::command_t signedCommand(const adit::runtime::CommandKey& key, const std::string& argument, std::int64_t counter) {
+  adit::command_t c = command("save_map", argument);
+  c.counter = counter;
+  const adit::runtime::CommandMac mac = adit::runtime::commandMac(key, "MAPPER_COMMAND", c.command, argument, counter);
+  c.mac.assign(mac.begin(), mac.end());
+  c.mac_size = static_cast<std::int32_t>(c.mac.size());
+  return c;
+}
+
+TEST(Commands, WithAKeyOnlySignedCommandsAreObeyed) {
+  MapOwnerInRunFolder owner;
+  auto& [parent, run, node, sink] = owner;
+  const adit::runtime::CommandKey key(32, 0x5a);
+  node->requireSignedCommands(key);
+  adit::test::deliver(*node, "ODOM_MAPPED", adit::test::mappedMessage(0), sink);
+  const std::int64_t now = adit::runtime::wallUtime();
+
+  adit::test::deliver(*node, "MAPPER_COMMAND", command("save_map", "unsigned"), sink);
+  adit::test::deliver(*node, "MAPPER_COMMAND", signedCommand(adit::runtime::CommandKey(32, 1), "other_key", now), sink);
+  adit::command_t altered = signedCommand(key, "signed", now);
+  altered.argument = "altered";
+  adit::test::deliver(*node, "MAPPER_COMMAND", altered, sink);
+  adit::test::deliver(*node, "MAPPER_COMMAND", signedCommand(key, "old", now - 3'600'000'000LL), sink);
+  EXPECT_EQ(filesIn(run), 0u) << "a command that is not authentic wrote a file";
+
+  const adit::command_t good = signedCommand(key, "signed", now);
+  adit::test::deliver(*node, "MAPPER_COMMAND", good, sink);
+  adit::test::deliver(*node, "MAPPER_COMMAND", good, sink);  // recorded and sent again
+  EXPECT_TRUE(fs::exists(fs::path(run) / "signed.pcd"));
+  EXPECT_EQ(counter(*node, "maps_saved"), 1);
+  EXPECT_EQ(counter(*node, "command_unsigned"), 1);
+  EXPECT_EQ(counter(*node, "command_bad_mac"), 2);
+  EXPECT_EQ(counter(*node, "command_stale"), 1);
+  EXPECT_EQ(counter(*node, "command_replayed"), 1);
+  // A signed command still names only a plain file in the run folder.
+  adit::test::deliver(*node, "MAPPER_COMMAND", signedCommand(key, "../evil", now + 1), sink);
+  EXPECT_EQ(counter(*node, "command_refused"), 1);
+  // A mac of the wrong size is not a message at all.
+  adit::command_t bad_size = signedCommand(key, "x", now + 2);
+  bad_size.mac.pop_back();
+  bad_size.mac_size = 31;
+  adit::test::deliver(*node, "MAPPER_COMMAND", bad_size, sink);
+  EXPECT_EQ(counter(*node, "maps_saved"), 1);
 }
 
 TEST(Commands, PlainFileNameRules) {

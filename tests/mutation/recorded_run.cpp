@@ -73,7 +73,7 @@ RecordedRun recordRun(const Config& config, double seconds, int seed) {
     g.header.seq = graph_seq++;
     run.events.push_back({"POSE_GRAPH", msg::encode(g), utime});
     if (keyframes.size() % 2 == 0) {
-      adit::command_t c;
+      adit::command_t c{};
       c.header = msg::makeHeader(utime, "");
       c.header.seq = command_seq++;
       c.command = "save_map";

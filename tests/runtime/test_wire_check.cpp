@@ -93,7 +93,8 @@ TEST(WireCheck, StringLengthsAreChecked) {
   m.command = "save_map";
   m.argument = "map.pcd";
   auto b = bytesOf(m);
-  const std::size_t at = b.size() - (4 + m.argument.size() + 1);  // the argument's length field
+  // The argument's length field: before the argument, the counter (8 bytes) and mac_size (4; no mac).
+  const std::size_t at = b.size() - (4 + m.argument.size() + 1) - 8 - 4;
   putInt32(b, at, 0);  // no room for the NUL: lcm-gen would assign length -1
   EXPECT_EQ(checkWire<adit::command_t>(b.data(), b.size()).verdict, WireVerdict::Malformed);
   putInt32(b, at, 0x7fffffff);
