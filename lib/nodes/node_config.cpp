@@ -9,6 +9,39 @@
 
 namespace adit::nodes {
 
+const ConfigTable<InputCheckConfig>& inputCheckConfigTable() {
+  using N = InputCheckConfig;
+  static const ConfigTable<N> table = [] {
+    ConfigTable<N> t("input");
+    t.add("max_future_s", &N::max_future_s, above(0), "s", "a stamp further ahead of the newest sensor time is held until the next messages confirm it")
+     .add("confirm_messages", &N::confirm_messages, between(1, 100), "", "messages that must continue from a held stamp before it is adopted")
+     .add("max_step_periods", &N::max_step_periods, above(1), "", "a sensor-stream step longer than this many typical periods needs the same confirmation")
+     .add("max_seq_gap", &N::max_seq_gap, atLeast(1), "", "a sequence gap above this is a restarted publisher (seq_reset), not lost input")
+     .add("max_elements", &N::max_elements, atLeast(1), "", "largest array a message may announce (elements, all dimensions together)")
+     .add("max_string_bytes", &N::max_string_bytes, atLeast(1), "B", "largest string a message may announce on the wire")
+     .add("max_text_length", &N::max_text_length, atLeast(1), "B", "longest text field accepted (command arguments, frame ids, STATUS text)")
+     .add("max_angular_velocity", &N::max_angular_velocity, above(0), "rad/s", "IMU rates beyond this are refused as invalid_range")
+     .add("max_acceleration", &N::max_acceleration, above(0), "m/s^2", "IMU accelerations beyond this are refused as invalid_range");
+    return t;
+  }();
+  return table;
+}
+
+runtime::InputChecks inputChecksFrom(const Config& config) {
+  const InputCheckConfig c = inputCheckConfigTable().read(config);
+  runtime::InputChecks checks;
+  checks.max_future_s = c.max_future_s;
+  checks.confirm_messages = c.confirm_messages;
+  checks.max_step_periods = c.max_step_periods;
+  checks.max_seq_gap = c.max_seq_gap;
+  checks.wire.max_elements = c.max_elements;
+  checks.wire.max_string_bytes = c.max_string_bytes;
+  checks.values.max_string_length = static_cast<std::size_t>(c.max_text_length);
+  checks.values.max_angular_velocity = c.max_angular_velocity;
+  checks.values.max_acceleration = c.max_acceleration;
+  return checks;
+}
+
 const ConfigTable<FeatureNodeConfig>& featureNodeConfigTable() {
   using N = FeatureNodeConfig;
   static const ConfigTable<N> table = [] {
@@ -84,6 +117,7 @@ std::vector<ConfigKeyInfo> pipelineConfigDescription(const Config& c) {
   describeInto(mapperNodeConfigTable(), mapperNodeConfigTable().read(c), keys);
   describeInto(loopCloserNodeConfigTable(), loopCloserNodeConfigTable().read(c), keys);
   describeInto(mapUpdateConfigTable(), mapUpdateConfigFrom(c), keys);
+  describeInto(inputCheckConfigTable(), inputCheckConfigTable().read(c), keys);
   std::vector<ConfigKeyInfo> out;
   for (auto& kv : keys) out.push_back(std::move(kv.second));
   return out;

@@ -3,7 +3,7 @@
 // and the validation run when a pipeline node is built or `adit config` loads a file.
 //
 // Section ownership. A configuration file may hold keys for several readers; each top-level section has one
-// owner. The pipeline owns `features`, `odometry`, `mapping`, `loop` and `ablation`: every key there must be
+// owner. The pipeline owns `features`, `odometry`, `mapping`, `loop`, `ablation` and `input`: every key there must be
 // in a table (an unknown one is an error naming it, its file and the nearest known key). The sections in
 // foreignConfigSections() are read by other code and skipped here: `sim` (lib/sim: adit sim / demo / bench),
 // `lidar_driver` (lib/drivers: adit-lidar-bridge), `pcd` and `imu_csv` (lib/io: importers, bridges), `eval`
@@ -12,6 +12,7 @@
 #pragma once
 
 #include "core/config_table.hpp"
+#include "runtime/node.hpp"
 
 #include <map>
 #include <string>
@@ -43,6 +44,25 @@ struct LoopCloserNodeConfig {
   double map_voxel = 0.1;         // key "loop.map_voxel" (kept where it always was)
   int checkpoint_keyframes = 10;  // key "loop.node.checkpoint_keyframes": keyframes between checkpoints (0 = never)
 };
+
+// Section `input`: the bus input checks every node applies (runtime/node.hpp InputChecks, msg/validate.hpp
+// InputLimits, msg/wire_check.hpp WireLimits), the same for every stage, so one file can tighten them for a
+// deployment (e.g. the IMU's real full scale) or loosen one that refuses a real sensor. Defaults are theirs.
+struct InputCheckConfig {
+  double max_future_s = runtime::InputChecks{}.max_future_s;
+  int confirm_messages = runtime::InputChecks{}.confirm_messages;
+  double max_step_periods = runtime::InputChecks{}.max_step_periods;
+  int max_seq_gap = static_cast<int>(runtime::InputChecks{}.max_seq_gap);
+  int max_elements = static_cast<int>(msg::WireLimits{}.max_elements);
+  int max_string_bytes = static_cast<int>(msg::WireLimits{}.max_string_bytes);
+  int max_text_length = static_cast<int>(msg::InputLimits{}.max_string_length);
+  double max_angular_velocity = msg::InputLimits{}.max_angular_velocity;
+  double max_acceleration = msg::InputLimits{}.max_acceleration;
+};
+
+const ConfigTable<InputCheckConfig>& inputCheckConfigTable();
+// The input checks under `config` (section `input`).
+runtime::InputChecks inputChecksFrom(const Config& config);
 
 const ConfigTable<FeatureNodeConfig>& featureNodeConfigTable();
 const ConfigTable<OdometryNodeConfig>& odometryNodeConfigTable();

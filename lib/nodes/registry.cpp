@@ -16,11 +16,14 @@ const std::vector<std::string>& pipelineNodeNames() {
 
 std::unique_ptr<runtime::Node> makeNode(const std::string& name, const Config& config) {
   validatePipelineConfig(config);
-  if (name == "feature") return makeFeatureNode(config);
-  if (name == "odometry") return makeOdometryNode(config);
-  if (name == "mapper") return makeMapperNode(config);
-  if (name == "loop_closer") return makeLoopCloserNode(config);
-  throw std::runtime_error("no pipeline node named '" + name + "'");
+  std::unique_ptr<runtime::Node> node;
+  if (name == "feature") node = makeFeatureNode(config);
+  else if (name == "odometry") node = makeOdometryNode(config);
+  else if (name == "mapper") node = makeMapperNode(config);
+  else if (name == "loop_closer") node = makeLoopCloserNode(config);
+  else throw std::runtime_error("no pipeline node named '" + name + "'");
+  node->setInputChecks(inputChecksFrom(config));
+  return node;
 }
 
 std::map<std::string, std::string> pipelineConfigKeys(const Config& config) {

@@ -161,3 +161,23 @@ TEST(ConfigValidation, TableDefaultsAreTheStructDefaultsAndDocumented) {
     }
   }
 }
+
+// The bus input checks come from section `input`, for every node the registry builds (how the checks act on
+// messages is tested in tests/runtime); without the section every node has the built-in limits.
+TEST(ConfigValidation, InputLimitsAreConfiguredForEveryNode) {
+  const Config tight = Config::fromYamlString(
+      "input:\n  max_angular_velocity: 5.0\n  max_future_s: 0.5\n  max_text_length: 100\n  max_elements: 1000\n");
+  for (const std::string& name : adit::nodes::pipelineNodeNames()) {
+    const auto node = adit::nodes::makeNode(name, tight);
+    EXPECT_DOUBLE_EQ(node->inputChecks().values.max_angular_velocity, 5.0) << name;
+    EXPECT_DOUBLE_EQ(node->inputChecks().max_future_s, 0.5) << name;
+    EXPECT_EQ(node->inputChecks().values.max_string_length, 100u) << name;
+    EXPECT_EQ(node->inputChecks().wire.max_elements, 1000) << name;
+    const auto standard = adit::nodes::makeNode(name, Config{});
+    EXPECT_DOUBLE_EQ(standard->inputChecks().values.max_angular_velocity, adit::msg::InputLimits{}.max_angular_velocity);
+    EXPECT_EQ(standard->inputChecks().max_seq_gap, adit::runtime::InputChecks{}.max_seq_gap);
+  }
+  EXPECT_NE(errorOf("input:\n  max_future_s: 0\n"), "");
+  EXPECT_NE(errorOf("input:\n  confirm_messages: 0\n"), "");
+  EXPECT_NE(errorOf("input:\n  max_angular_veloctiy: 5\n"), "");  // misspelt: unknown key
+}
