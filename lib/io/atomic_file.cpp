@@ -59,9 +59,13 @@ void writeFileAtomically(const std::string& path, const std::function<void(std::
   {
     std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
     if (!out) throw WriteError("cannot create '" + tmp + "': " + errnoText());
+    errno = 0;  // a failed stream keeps no error code; the failed write(2) behind it left one in errno
     write(out);
     out.flush();
-    if (!out) throw WriteError("write to '" + tmp + "' failed (disk full?)");
+    if (!out) {
+      const int error = errno;
+      throw WriteError("write to '" + tmp + "' failed: " + (error ? std::strerror(error) : "stream error (disk full?)"));
+    }
   }
   if (!fsyncPath(tmp, O_RDONLY)) throw WriteError("fsync of '" + tmp + "' failed: " + errnoText());
   if (std::rename(tmp.c_str(), path.c_str()) != 0)
