@@ -4,7 +4,7 @@
 #
 #   scripts/fuzz.sh [HARNESS...] [--seconds N] [--build-only | --no-build]
 #
-# HARNESS: pcd kitti lcmlog imu_text config launch_file lidar_packets node_messages (default: all).
+# HARNESS: pcd kitti lcmlog imu_text config launch_file lidar_packets n100_serial node_messages (default: all).
 # Each runs N seconds (default 60) from its seed corpus (tests/fuzz/corpus/<harness>, copied: the repository's
 # corpus is not changed); inputs it finds interesting stay in build-fuzz/corpus/<harness>, crashes go to
 # build-fuzz/findings/<harness>/. Prints per harness: executions, coverage (cov: edges, ft: features), findings.
@@ -16,7 +16,7 @@ BUILD=$ROOT/build-fuzz
 SECONDS_EACH=60
 BUILD_ONLY=0
 NO_BUILD=0
-ALL=(pcd kitti lcmlog imu_text config launch_file lidar_packets node_messages)
+ALL=(pcd kitti lcmlog imu_text config launch_file lidar_packets n100_serial node_messages)
 HARNESSES=()
 while [[ $# -gt 0 ]]; do
   case "$1" in

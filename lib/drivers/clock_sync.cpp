@@ -1,0 +1,83 @@
+#include "drivers/clock_sync.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace adit::drivers {
+
+DeviceClockSync::DeviceClockSync(ClockSyncConfig config) : config_(config) {}
+
+void DeviceClockSync::reset() {
+  minima_.clear();
+  have_current_ = false;
+  fitted_ = false;
+  slope_ = 0;
+}
+
+double DeviceClockSync::offsetAt(std::int64_t device_us) const {
+  return intercept_ + slope_ * static_cast<double>(device_us - ref_us_);
+}
+
+void DeviceClockSync::refit() {
+  // The open window's minimum is of a few samples only, so still high by their jitter: it is used only until
+  // two windows have closed.
+  std::deque<Minimum> points = minima_;
+  if (points.size() < 2 && have_current_) points.push_back(current_);
+  if (points.empty()) return;
+  ref_us_ = points.back().device_us;
+  if (points.size() < 3) {  // too short a baseline for a drift: the lowest minimum so far
+    intercept_ = std::min_element(points.begin(), points.end(), [](const Minimum& a, const Minimum& b) {
+                   return a.offset_us < b.offset_us;
+                 })->offset_us;
+    slope_ = 0;
+  } else {
+    double sx = 0, sy = 0, sxx = 0, sxy = 0;
+    const double n = static_cast<double>(points.size());
+    for (const Minimum& m : points) {
+      const double x = static_cast<double>(m.device_us - ref_us_);
+      sx += x;
+      sy += m.offset_us;
+      sxx += x * x;
+      sxy += x * m.offset_us;
+    }
+    const double denominator = n * sxx - sx * sx;
+    slope_ = denominator > 0 ? (n * sxy - sx * sy) / denominator : 0;
+    intercept_ = (sy - slope_ * sx) / n;
+  }
+  fitted_ = true;
+}
+
+std::int64_t DeviceClockSync::stamp(std::int64_t device_us, std::int64_t host_us) {
+  const double observed = static_cast<double>(host_us - device_us);
+  const double max_jump_us = config_.max_jump_s * 1e6;
+  if (fitted_ && std::abs(observed - offsetAt(device_us)) > max_jump_us) {
+    // Far from the fit: one late sample (ignored) or a new device clock (followed once confirmed).
+    far_in_a_row_ = std::abs(observed - far_offset_) <= max_jump_us ? far_in_a_row_ + 1 : 1;
+    far_offset_ = observed;
+    if (far_in_a_row_ < config_.jump_confirm) {
+      const auto out = static_cast<std::int64_t>(std::llround(device_us + offsetAt(device_us) - config_.transport_delay_s * 1e6));
+      last_out_ = std::max(out, last_out_ + 1);
+      return last_out_;
+    }
+    ++jumps_;
+    reset();
+  }
+  far_in_a_row_ = 0;
+  const auto window_us = static_cast<std::int64_t>(config_.window_s * 1e6);
+  if (!have_current_ || device_us - window_start_ >= window_us || device_us < window_start_) {
+    if (have_current_) minima_.push_back(current_);
+    while (static_cast<int>(minima_.size()) > std::max(config_.windows - 1, 0)) minima_.pop_front();
+    current_ = {device_us, observed};
+    window_start_ = device_us;
+    have_current_ = true;
+  } else if (observed < current_.offset_us) {
+    current_ = {device_us, observed};
+  }
+  refit();
+  const auto out = static_cast<std::int64_t>(std::llround(device_us + offsetAt(device_us) - config_.transport_delay_s * 1e6));
+  // A refit may move the line by microseconds; stamps must still advance.
+  last_out_ = last_out_ == INT64_MIN ? out : std::max(out, last_out_ + 1);
+  return last_out_;
+}
+
+}  // namespace adit::drivers
