@@ -3,6 +3,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <cstdlib>
+#include <filesystem>
 #include <optional>
 #include <stdexcept>
 
@@ -64,28 +65,70 @@ RestartLimits readLimits(const YAML::Node& node, RestartLimits base, const std::
 
 namespace {
 
-LaunchSpec readLaunchFile(const std::string& path, const std::map<std::string, std::string>& vars) {
+// `defaults:` gives variables a value where neither --set nor the environment does.
+std::map<std::string, std::string> withDefaults(const YAML::Node& root, std::map<std::string, std::string> vars) {
+  if (!root["defaults"]) return vars;
+  if (!root["defaults"].IsMap()) throw std::runtime_error("'defaults' must be a map of VARIABLE: value");
+  for (const auto& kv : root["defaults"]) {
+    const std::string name = kv.first.as<std::string>();
+    if (!vars.count(name) && !std::getenv(name.c_str())) vars[name] = kv.second.as<std::string>();
+  }
+  return vars;
+}
+
+// A process of the same name replaces the included one in place; others are appended.
+void addProcess(LaunchSpec& spec, ProcessSpec proc) {
+  for (ProcessSpec& existing : spec.processes)
+    if (existing.name == proc.name) {
+      existing = std::move(proc);
+      return;
+    }
+  spec.processes.push_back(std::move(proc));
+}
+
+constexpr int kMaxIncludeDepth = 4;
+
+LaunchSpec readLaunchFile(const std::string& path, const std::map<std::string, std::string>& given_vars, int depth) {
   YAML::Node root;
   try {
     root = YAML::LoadFile(path);
   } catch (const YAML::Exception& e) {
     throw std::runtime_error("launch file '" + path + "': " + e.what());
   }
+  std::map<std::string, std::string> vars;
+  try {
+    vars = withDefaults(root, given_vars);
+  } catch (const std::exception& e) {
+    throw std::runtime_error("launch file '" + path + "': " + e.what());
+  }
   const auto sub = [&](const YAML::Node& n, const std::string& field) { return substitute(n.as<std::string>(), vars, path + ": " + field); };
+  // `include:` (a path relative to this file): start from that file's run, then change what this one says.
   LaunchSpec spec;
-  spec.name = root["name"] ? sub(root["name"], "name") : "run";
-  spec.lcm_url = root["lcm_url"] ? sub(root["lcm_url"], "lcm_url") : "";
+  spec.recorder_limits.max_restarts = 3;
+  if (root["include"]) {
+    if (depth >= kMaxIncludeDepth)
+      throw std::runtime_error("launch file '" + path + "': includes nested deeper than " + std::to_string(kMaxIncludeDepth) + " (a cycle?)");
+    const std::filesystem::path included = std::filesystem::path(path).parent_path() / sub(root["include"], "include");
+    spec = readLaunchFile(included.string(), vars, depth + 1);
+  }
+  if (root["name"]) spec.name = sub(root["name"], "name");
+  else if (spec.name.empty()) spec.name = "run";
+  if (root["lcm_url"]) spec.lcm_url = sub(root["lcm_url"], "lcm_url");
   if (root["record"]) spec.record_channels = sub(root["record"], "record");
   if (root["grace_s"]) spec.grace_s = root["grace_s"].as<double>();
   spec.limits = readLimits(root, spec.limits, path);
-  spec.recorder_limits = spec.limits;
-  spec.recorder_limits.max_restarts = root["record_max_restarts"] ? root["record_max_restarts"].as<int>() : 3;
+  if (root["record_max_restarts"]) spec.recorder_limits.max_restarts = root["record_max_restarts"].as<int>();
+  spec.recorder_limits.window_s = spec.limits.window_s;
   if (spec.recorder_limits.max_restarts < 0) throw std::runtime_error(path + ": record_max_restarts must be >= 0");
   if (root["stop_when_exit"])
     for (const auto& n : root["stop_when_exit"]) spec.stop_when_exit.push_back(n.as<std::string>());
-  if (!root["processes"] || !root["processes"].IsSequence() || root["processes"].size() == 0)
+  const bool has_processes = root["processes"] && root["processes"].IsSequence() && root["processes"].size() > 0;
+  if (!has_processes && spec.processes.empty())
     throw std::runtime_error("launch file '" + path + "': needs a non-empty 'processes' list");
-  for (const auto& p : root["processes"]) {
+  if (root["processes"] && !root["processes"].IsSequence())
+    throw std::runtime_error("launch file '" + path + "': 'processes' must be a list");
+  const YAML::Node listed = has_processes ? root["processes"] : YAML::Node(YAML::NodeType::Sequence);
+  for (const auto& p : listed) {
     ProcessSpec proc;
     if (!p["name"] || !p["command"] || !p["command"].IsSequence())
       throw std::runtime_error("launch file '" + path + "': every process needs 'name' and a 'command' list");
@@ -94,7 +137,7 @@ LaunchSpec readLaunchFile(const std::string& path, const std::map<std::string, s
     if (p["delay_s"]) proc.delay_s = p["delay_s"].as<double>();
     if (p["restart"]) proc.restart = parseRestart(p["restart"].as<std::string>(), path + ": " + proc.name);
     proc.limits = readLimits(p, spec.limits, path + ": " + proc.name);
-    spec.processes.push_back(std::move(proc));
+    addProcess(spec, std::move(proc));
   }
   for (const auto& name : spec.stop_when_exit) {
     bool known = false;
@@ -108,7 +151,7 @@ LaunchSpec readLaunchFile(const std::string& path, const std::map<std::string, s
 
 LaunchSpec loadLaunchFile(const std::string& path, const std::map<std::string, std::string>& vars) {
   try {
-    return readLaunchFile(path, vars);
+    return readLaunchFile(path, vars, 0);
   } catch (const YAML::Exception& e) {  // a value of the wrong type: name the file, not just the line
     throw std::runtime_error("launch file '" + path + "': " + e.what());
   }

@@ -11,6 +11,7 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <fstream>
 #include <regex>
 #include <set>
 
@@ -92,4 +93,41 @@ TEST(ConfigFiles, LaunchFilesLoad) {
         }
   }
   EXPECT_GE(files, 3);
+}
+
+// `include:` and `defaults:` (the robot launch files build on live.launch.yaml): the included processes come
+// first, one of the same name is replaced, defaults yield to --set, and an include cycle is an error.
+TEST(LaunchFiles, RobotFilesIncludeTheLivePipelineWithTheirSensor) {
+  const std::map<std::string, std::string> vars{{"RUN_DIR", "run"}, {"ADIT_ROOT", ADIT_SOURCE_DIR}};
+  const std::string dir = std::string(ADIT_SOURCE_DIR) + "/launch/";
+  const auto robot = adit::launch::loadLaunchFile(dir + "robot-rs16-n100.launch.yaml", vars);
+  const auto live = adit::launch::loadLaunchFile(dir + "live.launch.yaml", vars);
+  EXPECT_EQ(robot.name, "robot-rs16-n100");
+  EXPECT_EQ(robot.lcm_url, live.lcm_url);
+  ASSERT_EQ(robot.processes.size(), live.processes.size() + 1);
+  EXPECT_EQ(robot.processes.back().name, "imu-bridge");
+  const auto& bridge = robot.processes[live.processes.size() - 1];
+  ASSERT_EQ(bridge.name, "lidar-bridge");
+  EXPECT_EQ(bridge.command[2], "rs16");
+  auto with_set = vars;
+  with_set["SENSOR"] = "vlp16";
+  EXPECT_EQ(adit::launch::loadLaunchFile(dir + "robot-rs16-n100.launch.yaml", with_set).processes[live.processes.size() - 1].command[2],
+            "vlp16");
+  EXPECT_EQ(adit::launch::loadLaunchFile(dir + "robot-vlp16.launch.yaml", vars).processes.size(), live.processes.size());
+
+  const std::string tmp = testing::TempDir();
+  std::ofstream(tmp + "a.launch.yaml") << "include: b.launch.yaml\nprocesses:\n  - {name: x, command: [true]}\n";
+  std::ofstream(tmp + "b.launch.yaml") << "include: a.launch.yaml\n";
+  try {
+    adit::launch::loadLaunchFile(tmp + "a.launch.yaml", vars);
+    ADD_FAILURE() << "an include cycle was accepted";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("nested"), std::string::npos) << e.what();
+  }
+  std::ofstream(tmp + "base.launch.yaml") << "name: base\nprocesses:\n  - {name: x, command: [sleep, '1']}\n  - {name: y, command: [true]}\n";
+  std::ofstream(tmp + "over.launch.yaml") << "include: base.launch.yaml\nprocesses:\n  - {name: x, command: [sleep, '2']}\n";
+  const auto over = adit::launch::loadLaunchFile(tmp + "over.launch.yaml", vars);
+  ASSERT_EQ(over.processes.size(), 2u);
+  EXPECT_EQ(over.processes[0].command[1], "2");
+  EXPECT_EQ(over.name, "base");
 }
