@@ -135,10 +135,12 @@ class ScanToScanOdometry {
     Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
     RegistrationResult result;  // of the last round
     int iterations = 0;
+    bool from_prior = false;    // start-up search: refined from the prior itself
   };
-  // The start-up search: the best refined seed among startupHypotheses(seed, ...) for an interval of gap_s.
-  Eigen::Isometry3d searchStart(const SweepPoints& cur, const Eigen::Isometry3d& seed, const Eigen::Isometry3d& hold,
-                                bool can_hold, double gap_s) const;
+  // The start-up search: the refinement of the seed among startupHypotheses(seed, ...) that explains most of
+  // the sweep, for an interval of gap_s (ok false if none could be refined).
+  Refinement searchStart(const SweepPoints& cur, const Eigen::Isometry3d& seed, const Eigen::Isometry3d& hold,
+                         bool can_hold, double gap_s) const;
   // Outer rounds (correspondences recomputed each) from `seed` until converged or out of rounds.
   Refinement refine(const SweepPoints& cur, const Eigen::Isometry3d& seed, const Eigen::Isometry3d& hold,
                     bool can_hold) const;
