@@ -80,7 +80,8 @@ class OdometryNode : public runtime::Node {
     if (resume_) resumeFrom(*resume_, features.utime);
     const std::vector<ImuSample> imu = imu_.samples();
     const InitialGuess guess = initialGuess(previous_ ? &*previous_ : nullptr, features,
-                                            odometry_.predictMotion(features.utime), imu, guess_config_);
+                                            odometry_.predictMotion(features.utime),
+                                            odometry_.hasVelocity(features.utime), imu, guess_config_);
     count("link3d_matches", guess.link3d_matches);
     if (guess.flags & PoseEstimate::kSeededByLinK3d) count("seeded_by_link3d");
     if (guess.flags & PoseEstimate::kSeededByImu) count("seeded_by_imu");

@@ -16,7 +16,8 @@ const ConfigTable<InitialGuessConfig>& initialGuessConfigTable() {
     t.add("use_link3d_seed", &G::use_link3d, anyValue(), "", "seed from LinK3D matches (false: motion model only, A-LOAM)")
      .add("use_imu_rotation", &G::use_imu, anyValue(), "", "gyro rotation between sweeps as the seed's rotation when the IMU covers it")
      .add("max_link3d_deviation_m", &G::max_link3d_deviation_m, above(0), "m", "a LinK3D seed farther from the motion model is a bad match set")
-     .add("max_link3d_deviation_deg", &G::max_link3d_deviation_deg, aboveUpTo(0, 180), "deg", "same for rotation");
+     .add("max_link3d_deviation_deg", &G::max_link3d_deviation_deg, aboveUpTo(0, 180), "deg", "same for rotation")
+     .add("startup_max_speed_mps", &G::startup_max_speed_mps, atLeast(0), "m/s", "fastest a vehicle may already move when odometry starts (start-up search range; 0 = no search)");
     return t;
   }();
   return table;
@@ -36,9 +37,14 @@ InitialGuessConfig initialGuessConfigFrom(const Config& c) {
 }
 
 InitialGuess initialGuess(const FeatureSet* previous, const FeatureSet& current, const Eigen::Isometry3d& motion_model,
-                          const std::vector<ImuSample>& imu, const InitialGuessConfig& config) {
+                          bool motion_known, const std::vector<ImuSample>& imu, const InitialGuessConfig& config) {
   InitialGuess guess;
   if (!previous) return guess;
+  const double interval = toSeconds(current.utime - previous->utime);
+  // Without a motion model the seed is judged by how far a vehicle can go in the interval.
+  const double max_deviation_m =
+      motion_known ? config.max_link3d_deviation_m
+                   : std::max(config.max_link3d_deviation_m, config.startup_max_speed_mps * interval);
   if (config.use_link3d && !previous->keypoints.empty() && !current.keypoints.empty()) {
     const auto matches = matchLinK3d(*previous, current, config.link3d);
     guess.link3d_matches = static_cast<int>(matches.size());
@@ -46,7 +52,7 @@ InitialGuess initialGuess(const FeatureSet* previous, const FeatureSet& current,
     const RansacResult r = estimateTransformRansac(previous->keypoints, current.keypoints, matches, config.ransac);
     guess.link3d_inliers = static_cast<int>(r.inliers.size());
     const Eigen::Isometry3d deviation = motion_model.inverse() * r.T_a_b;
-    if (r.ok && translationNorm(deviation) <= config.max_link3d_deviation_m &&
+    if (r.ok && translationNorm(deviation) <= max_deviation_m &&
         rotationAngle(deviation) <= config.max_link3d_deviation_deg * M_PI / 180.0) {
       guess.T_prev_curr = r.T_a_b;
       guess.flags = PoseEstimate::kSeededByLinK3d;
@@ -54,7 +60,6 @@ InitialGuess initialGuess(const FeatureSet* previous, const FeatureSet& current,
     }
   }
   if (config.use_imu && !imu.empty()) {
-    const double interval = toSeconds(current.utime - previous->utime);
     const auto rotations = features::imuRotations(imu, current.utime, {-interval}, config.R_lidar_imu, config.max_imu_gap_s);
     if (!rotations.empty()) {
       // rotations[0]: the lidar at the previous sweep in the current frame, i.e. R_curr_prev.

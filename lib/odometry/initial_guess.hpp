@@ -18,6 +18,10 @@ struct InitialGuessConfig {
   // (roadways repeat: a keypoint pattern can match one support arch further on).
   double max_link3d_deviation_m = 1.0;
   double max_link3d_deviation_deg = 15.0;
+  // With no motion model yet (start-up), a LinK3D seed is accepted up to this speed times the interval: the
+  // vehicle may already move (odometry.startup_max_speed_mps; the odometry's start-up search then weighs the
+  // seed against seeds along the forward axis, so a matched support arch one spacing off cannot win alone).
+  double startup_max_speed_mps = 30.0;
   LinK3dConfig link3d;
   RansacConfig ransac;
   Eigen::Quaterniond R_lidar_imu = Eigen::Quaterniond::Identity();
@@ -37,8 +41,9 @@ struct InitialGuess {
 };
 
 // previous may be null (first sweep). motion_model: the odometry's constant-velocity prediction of
-// T_prev_curr. imu: samples around the interval (any order of coverage; checked inside).
+// T_prev_curr; motion_known: false when that is the identity of ignorance (no velocity yet), not a
+// measured standstill. imu: samples around the interval (any order of coverage; checked inside).
 InitialGuess initialGuess(const FeatureSet* previous, const FeatureSet& current, const Eigen::Isometry3d& motion_model,
-                          const std::vector<ImuSample>& imu, const InitialGuessConfig& config);
+                          bool motion_known, const std::vector<ImuSample>& imu, const InitialGuessConfig& config);
 
 }  // namespace adit

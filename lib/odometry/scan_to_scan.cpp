@@ -2,6 +2,7 @@
 
 #include "registration/feature_fit.hpp"
 #include "odometry/motion_compensation.hpp"
+#include "odometry/startup_search.hpp"
 #include "registration/pose_increment.hpp"
 
 #include <algorithm>
@@ -33,6 +34,7 @@ ScanToScanConfig aloamOdometryConfig() {
   s.outer_iterations = 2;
   s.registration.max_solver_iterations = 4;
   s.max_match_distance_m = 5.0;
+  s.startup_max_speed_mps = 0.0;
   return s;
 }
 
@@ -63,7 +65,10 @@ const ConfigTable<ScanToScanConfig>& scanToScanConfigTable() {
      .add("compensate_mixed_deskew", &S::compensate_mixed_deskew, anyValue(), "", "move a raw sweep to its end instant when its neighbour is deskewed")
      .add("use_link3d_seed", &S::use_link3d_seed, anyValue(), "", "seed from LinK3D matches (false: motion model only, A-LOAM)")
      .add("max_velocity_gap_s", &S::max_velocity_gap_s, above(0), "s", "longest gap over which the constant-velocity model extrapolates")
-     .add("hold_velocity_time_constant_s", &S::hold_velocity_time_constant_s, atLeast(0), "s", "averaging of the velocity degenerate directions hold to; 0 = last motion");
+     .add("hold_velocity_time_constant_s", &S::hold_velocity_time_constant_s, atLeast(0), "s", "averaging of the velocity degenerate directions hold to; 0 = last motion")
+     .add("startup_max_speed_mps", &S::startup_max_speed_mps, atLeast(0), "m/s", "fastest a vehicle may already move when odometry starts (start-up search range; 0 = no search)")
+     .add("startup_search_step_m", &S::startup_search_step_m, above(0), "m", "spacing of the start-up search's seeds along the forward axis")
+     .add("startup_inlier_distance_m", &S::startup_inlier_distance_m, above(0), "m", "residual below which a correspondence counts for a start-up seed");
     return t;
   }();
   return table;
@@ -218,6 +223,24 @@ ScanToScanOdometry::Refinement ScanToScanOdometry::refine(const SweepPoints& cur
   return out;
 }
 
+ScanToScanOdometry::Refinement ScanToScanOdometry::searchStart(const SweepPoints& cur, const Eigen::Isometry3d& seed,
+                                                               const Eigen::Isometry3d& hold, bool can_hold,
+                                                               double gap_s) const {
+  const double reach = config_.startup_max_speed_mps * std::max(0.0, gap_s);
+  Refinement best;
+  best.pose = seed;
+  int best_inliers = -1;
+  const std::vector<Eigen::Isometry3d> hypotheses = startupHypotheses(seed, reach, config_.startup_search_step_m);
+  for (std::size_t i = 0; i < hypotheses.size(); ++i) {
+    Refinement r = refine(cur, hypotheses[i], hold, can_hold);
+    if (!r.ok) continue;
+    const int inliers = inlierCount(match(cur.sharp, cur.flat, r.pose), r.pose, config_.startup_inlier_distance_m);
+    r.from_prior = i == 0;
+    if (inliers > best_inliers) best = r, best_inliers = inliers;
+  }
+  return best;
+}
+
 void ScanToScanOdometry::setPrevious(const SweepPoints& points) {
   prev_points_ = points;
   prev_corners_ = RingIndexedCloud(points.less_sharp);
@@ -255,7 +278,16 @@ PoseEstimate ScanToScanOdometry::process(const FeatureSet& f, const std::optiona
   const SweepPoints raw_side = mixed ? (cur_raw ? cur : prev_points_) : SweepPoints{};
   Refinement r;
   r.pose = seed;
-  for (int pass = 0; has_previous_ && pass < (mixed ? 2 : 1); ++pass) {
+  // No motion history: the vehicle may already move fast; search along the forward axis. Where the prior
+  // wins (e.g. at rest) its refinement is the result, exactly as without the search; another winner started
+  // farther from the truth and is refined once more below (measured on kitti_mini 02: APE 0.033 -> 0.024 m).
+  bool refined = false;
+  if (has_previous_ && !hasVelocity(f.utime) && config_.startup_max_speed_mps > 0.0) {
+    r = searchStart(cur, seed, hold, can_hold, gap_s);
+    refined = r.ok && r.from_prior && !mixed;
+    if (!r.ok) r.pose = seed;
+  }
+  for (int pass = 0; has_previous_ && !refined && pass < (mixed ? 2 : 1); ++pass) {
     if (mixed) {
       SweepPoints fixed = raw_side;
       for (auto* v : {&fixed.sharp, &fixed.flat, &fixed.less_sharp, &fixed.less_flat}) compensateMotion(*v, r.pose, gap_s);

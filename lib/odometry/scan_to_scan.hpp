@@ -60,6 +60,16 @@ struct ScanToScanConfig {
   // carries whatever the last sweep said along the whole degenerate stretch. A robot's speed changes slowly
   // (0.3 m/s^2 is 3 cm/s a sweep), so averaging over ~1 s costs little lag. 0 = the last motion.
   double hold_velocity_time_constant_s = 1.0;
+  // Start-up search (startup_search.hpp): with no motion history (the first pair of a run, after a reset or a
+  // restart) the vehicle may already move at any speed up to startup_max_speed_mps. Seeds along the forward
+  // axis every startup_search_step_m, up to that speed times the interval, either way, are each refined and
+  // the one with the most correspondences within startup_inlier_distance_m is kept. The step is below the
+  // registration's reach from a seed (~0.5-1 m along a roadway with the 3 m matching radius). 30 m/s covers a
+  // road vehicle; a mine robot needs far less, but the search costs a few ms per seed, once. 0 = off: the
+  // first registration starts from the prior or zero motion (A-LOAM).
+  double startup_max_speed_mps = 30.0;
+  double startup_search_step_m = 0.5;
+  double startup_inlier_distance_m = 0.1;
 };
 
 // Plain A-LOAM laserOdometry behaviour, for the "before vs after" ablation: motion-model seed only (LinK3D
@@ -125,7 +135,12 @@ class ScanToScanOdometry {
     Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
     RegistrationResult result;  // of the last round
     int iterations = 0;
+    bool from_prior = false;    // start-up search: refined from the prior itself
   };
+  // The start-up search: the refinement of the seed among startupHypotheses(seed, ...) that explains most of
+  // the sweep, for an interval of gap_s (ok false if none could be refined).
+  Refinement searchStart(const SweepPoints& cur, const Eigen::Isometry3d& seed, const Eigen::Isometry3d& hold,
+                         bool can_hold, double gap_s) const;
   // Outer rounds (correspondences recomputed each) from `seed` until converged or out of rounds.
   Refinement refine(const SweepPoints& cur, const Eigen::Isometry3d& seed, const Eigen::Isometry3d& hold,
                     bool can_hold) const;

@@ -32,7 +32,7 @@ std::vector<double> speedProfile(const Path2d& path, const MotionConfig& c, bool
     v[i] = std::max(0.05, limit);
   }
   const double ds = path.length() / n;
-  v[0] = 0.0;
+  v[0] = std::min(std::max(0.0, c.start_speed), v[0]);
   for (int i = 0; i < n; ++i) v[i + 1] = std::min(v[i + 1], std::sqrt(v[i] * v[i] + 2 * c.max_accel * ds));
   if (stop_at_end) v[n] = 0.0;
   for (int i = n; i > 0; --i) v[i - 1] = std::min(v[i - 1], std::sqrt(v[i] * v[i] + 2 * c.max_decel * ds));
@@ -53,6 +53,7 @@ MotionConfig motionConfigFrom(const adit::Config& cfg) {
   c.corner_radius = cfg.get(p + "corner_radius", c.corner_radius);
   c.wander = cfg.get(p + "wander", c.wander);
   c.start_still = cfg.get(p + "start_still", c.start_still);
+  c.start_speed = cfg.get(p + "start_speed", c.start_speed);
   c.mount_height = cfg.get(p + "mount_height", c.mount_height);
   c.track_length = cfg.get(p + "track_length", c.track_length);
   c.track_width = cfg.get(p + "track_width", c.track_width);
@@ -84,11 +85,13 @@ class SpeedPlan {
     for (int i = 0; i < n_; ++i) t_grid_[i + 1] = t_grid_[i] + 2 * ds_ / std::max(1e-6, v_[i] + v_[i + 1]);
   }
 
+  // Before the start the robot stands still, or, if it starts moving (v[0] > 0), it was driving at v[0]
+  // (negative distance: behind the route's start).
   double distanceAt(double t, double& speed) const {
     t -= start_;
     if (t <= 0.0 || n_ <= 0) {
-      speed = 0.0;
-      return 0.0;
+      speed = n_ > 0 ? v_[0] : 0.0;
+      return speed > 0.0 ? speed * t : 0.0;
     }
     if (t >= t_grid_[n_]) {
       speed = v_[n_];
@@ -191,9 +194,10 @@ PlannedMotion planMotion(const World& world, const MotionConfig& c, double durat
   }
   const Path2d path(waypoints, c.corner_radius);
   // The smoothing below reaches smoothing_window back in time: start moving that much later so the robot is
-  // exactly still for start_still seconds.
+  // exactly still for start_still seconds. A robot already moving starts at once.
+  const bool moving_start = c.start_speed > 0.0;
   const SpeedPlan plan(path, speedProfile(path, c, !world.route_closed, rng),
-                       c.start_still + std::max(0.0, c.smoothing_window));
+                       moving_start ? 0.0 : c.start_still + std::max(0.0, c.smoothing_window));
   const double w1 = rng.uniform(20.0, 35.0), w2 = rng.uniform(45.0, 80.0);
   const double q1 = rng.uniform(0.0, 2 * M_PI), q2 = rng.uniform(0.0, 2 * M_PI);
   auto wander = [&](double s) {
@@ -216,7 +220,8 @@ PlannedMotion planMotion(const World& world, const MotionConfig& c, double durat
     out.knot_times[k] = knotTime(k);
     out.knot_distance[k] = plan.distanceAt(knotTime(k), speeds[k]);
     const double s = std::min(out.knot_distance[k], path.length());
-    const Path2d::Sample ps = path.at(s);
+    Path2d::Sample ps = path.at(s);
+    if (s < 0.0) ps.position += s * Eigen::Vector2d(std::cos(ps.heading), std::sin(ps.heading));  // behind the start
     const double offset = wander(s), slope = (wander(s + 0.05) - wander(s - 0.05)) / 0.1;
     xs[k] = ps.position.x() - offset * std::sin(ps.heading);
     ys[k] = ps.position.y() + offset * std::cos(ps.heading);

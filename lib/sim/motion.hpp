@@ -5,6 +5,7 @@
 //  - speed profile along the route: cruise speed with slow +-variation, slowed to the lateral-acceleration limit
 //    in corners (turns at junctions), accelerations limited to max_accel / max_decel, starting from rest after
 //    a still period (lets IMU-based pipelines initialise gravity and biases) and stopping at the route's end;
+//    or, with start_speed > 0, already driving at that speed at time 0 (a log cut from the middle of a drive);
 //  - a slow lateral wander around the centre line (nobody drives a perfect line);
 //  - the planar motion is smoothed (moving average, twice, over smoothing_window) so curvature and acceleration
 //    change continuously, as a real vehicle's do;
@@ -35,7 +36,8 @@ struct MotionConfig {
   double lateral_accel = 0.3;    // m/s^2 in corners -> ~0.77 m/s through a 2 m radius turn
   double corner_radius = 2.0;    // m, fits a 4.5 m wide junction
   double wander = 0.15;          // m, amplitude of the lateral wander around the centre line
-  double start_still = 2.0;      // s standing still at the start
+  double start_still = 2.0;      // s standing still at the start (ignored when start_speed > 0)
+  double start_speed = 0.0;      // m/s already driven at time 0 (capped by the speed limits there); 0 = from rest
   double mount_height = 1.0;     // m, lidar above the ground contact
   double track_length = 1.2;     // m, length of the tracks on the ground (pitch from the floor)
   double track_width = 0.8;      // m, distance between the tracks (roll from the floor)

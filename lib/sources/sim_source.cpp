@@ -46,6 +46,7 @@ bool SimSource::next(runtime::OutgoingMessage& out) {
     if (first_utime_ < 0) first_utime_ = utime;
     if (scan) ++sweeps_;
     const double t_s = static_cast<double>(utime - first_utime_) * 1e-6;
+    if (!scan && channels_.imu.empty()) continue;
     if (!(scan ? stalls_.lidar : stalls_.imu).covers(t_s)) break;
     if (!scan) ++imu_seq_;
   }

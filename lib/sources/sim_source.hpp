@@ -13,7 +13,7 @@ namespace adit::sources {
 
 struct SimChannels {
   std::string lidar = "LIDAR_POINTS";
-  std::string imu = "IMU";
+  std::string imu = "IMU";                    // "" = no IMU (a vehicle without one)
   std::string ground_truth = "GROUND_TRUTH";  // "" = do not publish
   // false: sweeps as full-float point_cloud_t, the format of logs before lidar_scan_t (tests of old logs).
   bool compact_sweeps = true;

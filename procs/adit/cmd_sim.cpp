@@ -14,9 +14,9 @@ namespace {
 struct SimArgs {
   std::vector<std::string> configs;
   std::string world, sensor, output, gt, world_pcd, lcm_url;
-  double duration_s = -1, rate = 1.0, world_spacing = 0.1;
+  double duration_s = -1, rate = 1.0, world_spacing = 0.1, start_speed = -1;
   std::int64_t seed = -1;
-  bool live = false, no_truth_channel = false;
+  bool live = false, no_truth_channel = false, no_imu = false;
   std::string stall_lidar, stall_imu;
 };
 
@@ -59,6 +59,11 @@ void registerSimCommand(CLI::App& app) {
   cmd->add_option("--rate", a->rate, "With --live: multiple of real time (0 = as fast as possible)")->check(CLI::NonNegativeNumber);
   cmd->add_option("--lcm-url", a->lcm_url, "With --live: LCM provider (default: $LCM_DEFAULT_URL or udpm)");
   cmd->add_flag("--no-ground-truth-channel", a->no_truth_channel, "Do not publish GROUND_TRUTH");
+  cmd->add_option("--start-speed", a->start_speed,
+                  "Already driving at this speed (m/s) at time 0, as a log cut from a drive (sim.motion.start_speed; "
+                  "raise sim.motion.cruise_speed / max_speed with it for a road vehicle)")
+      ->check(CLI::NonNegativeNumber);
+  cmd->add_flag("--no-imu", a->no_imu, "Publish no IMU (a vehicle without one)");
   cmd->add_option("--stall-lidar", a->stall_lidar,
                   "Fault test: publish no LIDAR_POINTS (nor their GROUND_TRUTH) from START for SECONDS of sensor "
                   "time (START:SECONDS)");
@@ -70,9 +75,11 @@ void registerSimCommand(CLI::App& app) {
     if (!a->sensor.empty()) config.sensor = a->sensor;
     if (a->duration_s > 0) config.duration_s = a->duration_s;
     if (a->seed >= 0) config.seed = static_cast<std::uint64_t>(a->seed);
+    if (a->start_speed >= 0) config.motion.start_speed = a->start_speed;
 
     adit::sources::SimChannels channels;
     if (a->no_truth_channel) channels.ground_truth.clear();
+    if (a->no_imu) channels.imu.clear();
     const adit::sources::SimStalls stalls{parseStall(a->stall_lidar, "--stall-lidar"),
                                           parseStall(a->stall_imu, "--stall-imu")};
     adit::sources::SimSource source(config, channels, stalls);

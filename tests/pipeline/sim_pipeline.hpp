@@ -14,6 +14,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <functional>
 #include <string>
 
 namespace adit::test {
@@ -29,7 +30,14 @@ struct SimPipelineRun {
 constexpr double kFalseLoopMetres = 1.0;
 constexpr double kFalseLoopDegrees = 5.0;
 
-inline SimPipelineRun runSimPipeline(const std::string& world, double duration_s, std::uint64_t seed) {
+// What a test changes beyond world, duration and seed.
+struct SimPipelineSetup {
+  std::function<void(sim::SimConfig&)> adjust;  // e.g. motion.start_speed
+  bool imu = true;                              // false: the simulator publishes no IMU
+};
+
+inline SimPipelineRun runSimPipeline(const std::string& world, double duration_s, std::uint64_t seed,
+                                     const SimPipelineSetup& setup = {}) {
   namespace fs = std::filesystem;
   const fs::path launch = fs::path(ADIT_SOURCE_DIR) / "launch";
   const Config config = runtime::loadConfig(
@@ -38,11 +46,17 @@ inline SimPipelineRun runSimPipeline(const std::string& world, double duration_s
   sim.world = world;
   sim.duration_s = duration_s;
   sim.seed = seed;
-  sources::SimSource source(sim, {});
+  if (setup.adjust) setup.adjust(sim);
+  sources::SimChannels channels;
+  if (!setup.imu) channels.imu.clear();
+  sources::SimSource source(sim, channels);
 
   pipeline::ReplayOptions options;
   options.source = &source;
-  options.out_dir = (fs::temp_directory_path() / ("adit_pipeline_" + world + "_" + std::to_string(::getpid()))).string();
+  static int runs = 0;  // several runs in one test process
+  options.out_dir = (fs::temp_directory_path() /
+                     ("adit_pipeline_" + world + "_" + std::to_string(::getpid()) + "_" + std::to_string(runs++)))
+                        .string();
   options.config = config;
   options.record = "^LOOP_CLOSURE$";
   pipeline::runReplay(options);

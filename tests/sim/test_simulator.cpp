@@ -153,6 +153,31 @@ TEST(SimulatorLoop, DrivesTheCircuitMoreThanOnceInTheDemoDuration) {
               "%.2f m/s^2\n", max_speed, max_accel, max_full_speed, max_full_accel);
 }
 
+// sim.motion.start_speed: the robot is already driving at t = 0, at that speed, and keeps driving; without it
+// it stands still for start_still seconds. Planned motion (flat floor, no vibration) so the speed is the plan's.
+TEST(SimulatorMotion, StartsAtTheConfiguredSpeed) {
+  for (const double v0 : {1.5, 15.0}) {
+    SimConfig c = shortRun("roadway-straight", 2);
+    c.motion.start_speed = v0;
+    c.motion.cruise_speed = c.motion.max_speed = v0;
+    c.motion.speed_variation = c.motion.vibration_deg = c.motion.bounce = 0.0;
+    c.roadway = worldConfigFor("roadway-straight", 2);
+    c.roadway->floor_roughness = c.roadway->grade_amplitude = 0.0;
+    const Simulator sim(c);
+    for (const double t : {0.0, 0.05, 0.1, 1.0, 2.5}) {
+      const TrajectoryState s = sim.trajectory().state(t);
+      EXPECT_NEAR(s.velocity.norm(), v0, 0.02 * v0) << "v0 " << v0 << " t " << t;
+      EXPECT_GT(s.velocity.x(), 0.95 * v0) << "heading +x";
+    }
+    // Ground truth of consecutive sweeps 0.1 s apart: v0 * 0.1 s between them from the first sweep on.
+    const double first = (sim.groundTruth(sim.sweepUtime(1)).pose.translation() -
+                          sim.groundTruth(sim.sweepUtime(0)).pose.translation()).norm();
+    EXPECT_NEAR(first, 0.1 * v0, 0.02 * v0) << v0;
+  }
+  const Simulator still(shortRun("roadway-straight", 2));
+  EXPECT_LT(still.trajectory().state(1.0).velocity.norm(), 1e-9);
+}
+
 TEST(SimulatorConfig, KeysAndErrors) {
   adit::Config cfg;
   cfg.set("sim.world", "featureless");
@@ -210,7 +235,8 @@ TEST(SimulatorConfig, ReferenceWorldFileMatchesTheDefaults) {
            {c.motion.max_speed, d.motion.max_speed}, {c.motion.max_accel, d.motion.max_accel},
            {c.motion.max_decel, d.motion.max_decel}, {c.motion.lateral_accel, d.motion.lateral_accel},
            {c.motion.corner_radius, d.motion.corner_radius}, {c.motion.wander, d.motion.wander},
-           {c.motion.start_still, d.motion.start_still}, {c.motion.mount_height, d.motion.mount_height},
+           {c.motion.start_still, d.motion.start_still}, {c.motion.start_speed, d.motion.start_speed},
+           {c.motion.mount_height, d.motion.mount_height},
            {c.motion.track_length, d.motion.track_length}, {c.motion.track_width, d.motion.track_width},
            {c.motion.vibration_deg, d.motion.vibration_deg}, {c.motion.bounce, d.motion.bounce},
            {c.motion.vibration_min_hz, d.motion.vibration_min_hz}, {c.motion.vibration_max_hz, d.motion.vibration_max_hz},
