@@ -182,7 +182,8 @@ void LoopCloser::addKeyframe(const PoseEstimate& mapped, const LidarScan& cloud)
   Keyframe kf;
   kf.utime = mapped.utime;
   kf.uncorrected = mapped.pose;
-  kf.cloud = voxelDownsample(points, config_.keyframe_voxel);
+  kf.cloud = CompactCloud::encode(voxelDownsample(points, config_.keyframe_voxel),
+                                  static_cast<float>(config_.keyframe_cloud_step));
 
   if (keyframes_.empty()) {
     chain_.add(mapped.pose, Matrix6d::Zero());
@@ -238,7 +239,7 @@ std::vector<Eigen::Vector3f> LoopCloser::correctedMap(double voxel) const {
   std::vector<Eigen::Vector3f> points;
   for (std::size_t k = 0; k < keyframes_.size(); ++k) {
     const Eigen::Isometry3f T = graph_.pose(static_cast<int>(k)).cast<float>();
-    for (const Eigen::Vector3f& p : keyframes_[k].cloud) points.push_back(T * p);
+    for (const Eigen::Vector3f& p : keyframes_[k].cloud.decode()) points.push_back(T * p);
   }
   return voxelDownsample(points, voxel);
 }
