@@ -76,6 +76,14 @@ std::vector<std::unique_ptr<runtime::Node>> buildNodes(const ReplayOptions& opti
     nodes.back()->cpuTiming().setCapacity(0);
     report.stages_run.push_back(name);
   }
+  // Only the last map writer's map.pcd is kept (writeProducts below): the others need not build one.
+  bool map_written_later = false;
+  for (auto it = nodes.rbegin(); it != nodes.rend(); ++it) {
+    auto* writer = dynamic_cast<nodes::WritesProducts*>(it->get());
+    if (!writer) continue;
+    if (map_written_later) writer->mapWrittenLater();
+    map_written_later = map_written_later || writer->writesMap();
+  }
   return nodes;
 }
 
