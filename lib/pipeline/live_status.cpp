@@ -34,8 +34,11 @@ std::vector<BenchFigure> liveFigures(const std::map<std::string, adit::status_t>
     }
     const std::int64_t n = statusCounter(s, "points_to_mapped_samples");
     if (n >= 0) figures.push_back({"latency_points_to_mapped.samples", static_cast<double>(n), "sweeps", true});
+    const std::int64_t lost = statusCounter(s, "points_to_mapped_unmatched");
+    if (lost >= 0) figures.push_back({"latency_points_to_mapped.unmatched", static_cast<double>(lost), "sweeps", false});
   }
   for (const auto& [process, s] : last_status) {
+    if (s.inputs == 0) continue;  // a source (the simulator): no stage timing
     figures.push_back({process + ".proc_p50_ms", s.proc_ms_p50, "ms", false});
     figures.push_back({process + ".proc_p95_ms", s.proc_ms_p95, "ms", false});
     figures.push_back({process + ".inputs", static_cast<double>(s.inputs), "", true});
