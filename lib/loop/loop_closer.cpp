@@ -182,7 +182,8 @@ void LoopCloser::addKeyframe(const PoseEstimate& mapped, const LidarScan& cloud)
   Keyframe kf;
   kf.utime = mapped.utime;
   kf.uncorrected = mapped.pose;
-  kf.cloud = voxelDownsample(points, config_.keyframe_voxel);
+  kf.cloud = CompactCloud::encode(voxelDownsample(points, config_.keyframe_voxel),
+                                  static_cast<float>(config_.keyframe_cloud_step));
 
   if (keyframes_.empty()) {
     chain_.add(mapped.pose, Matrix6d::Zero());
@@ -235,12 +236,21 @@ Trajectory LoopCloser::correctedTrajectory(const Trajectory& uncorrected) const 
 }
 
 std::vector<Eigen::Vector3f> LoopCloser::correctedMap(double voxel) const {
+  // Keyframe by keyframe into the grid: a 30-minute run's keyframes hold ~10^7 points, far more than its map.
   std::vector<Eigen::Vector3f> points;
+  std::optional<VoxelAccumulator> grid;
+  if (voxel > 0) grid.emplace(voxel);
   for (std::size_t k = 0; k < keyframes_.size(); ++k) {
     const Eigen::Isometry3f T = graph_.pose(static_cast<int>(k)).cast<float>();
-    for (const Eigen::Vector3f& p : keyframes_[k].cloud) points.push_back(T * p);
+    for (const Eigen::Vector3f& p : keyframes_[k].cloud.decode()) {
+      if (grid) {
+        grid->add(T * p);
+      } else if (const Eigen::Vector3f w = T * p; w.allFinite()) {
+        points.push_back(w);
+      }
+    }
   }
-  return voxelDownsample(points, voxel);
+  return grid ? grid->centroids() : points;
 }
 
 }  // namespace adit

@@ -55,6 +55,7 @@ const ConfigTable<LoopCloserConfig>& loopCloserConfigTable() {
     t.add("keyframe_distance", &K::keyframe_distance, above(0), "m", "mapped motion between keyframes")
      .add("keyframe_angle_deg", &K::keyframe_angle_deg, above(0), "deg", "mapped rotation between keyframes")
      .add("keyframe_voxel", &K::keyframe_voxel, between(0.01, 100), "m", "voxel of the cloud kept per keyframe")
+     .add("keyframe_cloud_step", &K::keyframe_cloud_step, between(0.0001, 1), "m", "quantisation step of the kept keyframe clouds (int16 counts)")
      .add("level_scan_context", &K::level_scan_context, anyValue(), "", "build Scan Context in a gravity-levelled frame")
      .nest(&K::scan_context, scanContextTable())
      .add("candidates", &K::candidates, between(1, 1000), "", "ring-key neighbours ranked per query")

@@ -61,7 +61,9 @@ std::string LoopCloser::keyframeRecord(int k) const {
   const Keyframe& kf = keyframes_[static_cast<std::size_t>(k)];
   w.put<std::int64_t>(kf.utime);
   w.putPose(kf.uncorrected);
-  w.putPoints(kf.cloud);
+  w.put<float>(kf.cloud.step());
+  w.put<std::uint64_t>(kf.cloud.counts().size());
+  for (std::int16_t c : kf.cloud.counts()) w.put<std::int16_t>(c);
   const ScanContext& sc = database_.context(k);
   w.put<std::int32_t>(sc.rings());
   w.put<std::int32_t>(sc.sectors());
@@ -113,7 +115,12 @@ bool LoopCloser::restoreState(const std::string& state, const std::vector<std::s
     Keyframe kf;
     kf.utime = kr.get<std::int64_t>();
     kf.uncorrected = kr.getPose();
-    kf.cloud = kr.getPoints<Eigen::Vector3f>();
+    const float cloud_step = kr.get<float>();
+    std::vector<std::int16_t> counts(kr.getCount(sizeof(std::int16_t)));
+    for (std::int16_t& c : counts) c = kr.get<std::int16_t>();
+    std::optional<CompactCloud> cloud = CompactCloud::fromCounts(cloud_step, std::move(counts));
+    if (!kr.ok() || !cloud) return false;
+    kf.cloud = std::move(*cloud);
     const int rings = kr.get<std::int32_t>(), sectors = kr.get<std::int32_t>(), radius = kr.get<std::int32_t>();
     if (!kr.ok() || rings <= 0 || sectors <= 0 || rings > 1000 || sectors > 1000 ||
         static_cast<std::uint64_t>(rings) * static_cast<std::uint64_t>(sectors) * 4 > record.size())

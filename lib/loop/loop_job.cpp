@@ -60,8 +60,12 @@ class JobRun {
   }
 
   std::optional<LoopConstraint> verify(const LoopCandidateSnapshot& c) {
+    // Decoded here, on the worker: the main thread only copies the compact clouds into the job.
+    std::vector<std::vector<Eigen::Vector3f>> clouds;
+    clouds.reserve(c.clouds.size());
+    for (const CompactCloud& cloud : c.clouds) clouds.push_back(cloud.decode());
     std::vector<SubmapPiece> pieces;
-    for (std::size_t i = 0; i < c.clouds.size(); ++i) pieces.push_back({&c.clouds[i], c.T_match_cloud[i]});
+    for (std::size_t i = 0; i < clouds.size(); ++i) pieces.push_back({&clouds[i], c.T_match_cloud[i]});
     const std::vector<Eigen::Vector3f> submap = buildSubmap(pieces, config_.verifier.submap_voxel);
 
     // Seeds: the Scan Context yaw at zero offset (levelled frames: query = Rz(yaw) * match), then the graph's
@@ -76,7 +80,7 @@ class JobRun {
     const Eigen::Isometry3d T_graph = job_.graph.pose(m).inverse() * job_.graph.pose(job_.query);
     const std::vector<Eigen::Isometry3d> seeds{rotationOnly(L_m.transpose() * R_yaw * L_q), T_graph};
 
-    const LoopVerification v = verifyLoop(job_.query_cloud, submap, seeds, config_.verifier);
+    const LoopVerification v = verifyLoop(job_.query_cloud.decode(), submap, seeds, config_.verifier);
     if (v.verdict == LoopVerdict::kDegenerate) {
       ++counts_.rejected_degenerate;
       return std::nullopt;

@@ -31,7 +31,7 @@ struct LoopCandidateSnapshot {
   ScanContextCandidate candidate;
   std::int64_t match_utime = 0;
   Eigen::Isometry3d match_uncorrected = Eigen::Isometry3d::Identity();
-  std::vector<std::vector<Eigen::Vector3f>> clouds;  // the candidate's neighbours, lidar frame
+  std::vector<CompactCloud> clouds;                  // the candidate's neighbours, lidar frame
   std::vector<Eigen::Isometry3d> T_match_cloud;      // each at its graph pose relative to the candidate
 };
 
@@ -39,7 +39,7 @@ struct LoopJob {
   int query = -1;
   std::int64_t query_utime = 0;
   Eigen::Isometry3d query_uncorrected = Eigen::Isometry3d::Identity();
-  std::vector<Eigen::Vector3f> query_cloud;
+  CompactCloud query_cloud;
   std::vector<LoopCandidateSnapshot> candidates;  // best first, at most max_verifications, under the threshold
   PoseGraph graph;      // nodes 0..query with the loop edges the main thread has applied
   OdometryChain chain;  // keyframes 0..query

@@ -36,4 +36,30 @@ std::vector<Eigen::Vector3f> voxelDownsample(const std::vector<Eigen::Vector3f>&
   return out;
 }
 
+std::size_t VoxelAccumulator::KeyHash::operator()(const Key& k) const {
+  std::size_t h = 1469598103934665603ull;
+  for (long long v : k) h = (h ^ static_cast<std::size_t>(v)) * 1099511628211ull;
+  return h;
+}
+
+void VoxelAccumulator::add(const Eigen::Vector3f& p) {
+  if (!p.allFinite()) return;
+  Key k;
+  for (int d = 0; d < 3; ++d) k[static_cast<std::size_t>(d)] = static_cast<long long>(std::floor(p[d] / voxel_));
+  Sum& s = cells_[k];
+  s.sum += p.cast<double>();
+  ++s.count;
+}
+
+std::vector<Eigen::Vector3f> VoxelAccumulator::centroids() const {
+  std::vector<std::pair<Key, const Sum*>> sorted;
+  sorted.reserve(cells_.size());
+  for (const auto& kv : cells_) sorted.emplace_back(kv.first, &kv.second);
+  std::sort(sorted.begin(), sorted.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+  std::vector<Eigen::Vector3f> out;
+  out.reserve(sorted.size());
+  for (const auto& [key, s] : sorted) out.push_back((s->sum / static_cast<double>(s->count)).cast<float>());
+  return out;
+}
+
 }  // namespace adit

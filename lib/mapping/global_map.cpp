@@ -6,7 +6,8 @@
 
 namespace adit {
 
-GlobalMap::GlobalMap(double resolution) : resolution_(resolution > 0 ? resolution : 0.1) {}
+GlobalMap::GlobalMap(double resolution, std::size_t max_voxels)
+    : resolution_(resolution > 0 ? resolution : 0.1), max_voxels_(max_voxels) {}
 
 void GlobalMap::insert(const std::vector<Eigen::Vector3f>& sweep_points, const Eigen::Isometry3d& T_world_sweep,
                        double max_range) {
@@ -30,6 +31,29 @@ void GlobalMap::insert(const std::vector<Eigen::Vector3f>& sweep_points, const E
     c.sum += w;
     ++c.count;
   }
+  while (max_voxels_ > 0 && cells_.size() > max_voxels_) coarsen();
+}
+
+// Doubles the resolution: each voxel's centroid joins its parent voxel, weighted by its samples. Merged in
+// key order (not the hash table's), so the sums, and the map, do not depend on the table's layout.
+void GlobalMap::coarsen() {
+  std::vector<std::pair<VoxelKey, Cell>> sorted(cells_.begin(), cells_.end());
+  std::sort(sorted.begin(), sorted.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+  cells_.clear();
+  resolution_ *= 2.0;
+  ++coarsenings_;
+  const auto parent = [](std::int32_t i) { return i >= 0 ? i / 2 : -((-i + 1) / 2); };  // floor(i / 2)
+  for (const auto& [key, cell] : sorted) {
+    Cell& merged = cells_[VoxelKey{parent(key.x), parent(key.y), parent(key.z)}];
+    merged.sum += cell.sum;
+    merged.count += cell.count;
+    // Keep the sum of at most kMaxSamplesPerCell samples (its float precision), as insert() does.
+    if (merged.count > kMaxSamplesPerCell) {
+      merged.sum *= static_cast<float>(kMaxSamplesPerCell) / static_cast<float>(merged.count);
+      merged.count = kMaxSamplesPerCell;
+    }
+  }
+  cells_.rehash(0);  // give back the buckets of the finer grid
 }
 
 std::vector<Eigen::Vector3f> GlobalMap::points(double voxel_size) const {

@@ -1,5 +1,8 @@
-// The map saved as map.pcd: every registered sweep folded into a voxel grid of fixed resolution (one
-// centroid per voxel). Memory grows with the explored volume, not with time.
+// The mapper's own map.pcd (replay without the loop closer): every registered sweep folded into a voxel
+// grid (one centroid per voxel). Memory grows with the explored surface, so it is bounded: when it would
+// hold more than max_voxels voxels, the grid's resolution doubles (eight voxels merge into one) until it
+// fits again. A long run thus keeps its whole extent at a coarser resolution, never loses a region, and
+// never holds more than max_voxels voxels (~56 bytes each).
 #pragma once
 
 #include "mapping/voxel_key.hpp"
@@ -13,7 +16,8 @@ namespace adit {
 
 class GlobalMap {
  public:
-  explicit GlobalMap(double resolution);
+  // max_voxels 0: unbounded.
+  explicit GlobalMap(double resolution, std::size_t max_voxels = 0);
 
   // Adds points given in the sweep frame, placed with T_world_sweep; points beyond max_range are skipped.
   void insert(const std::vector<Eigen::Vector3f>& sweep_points, const Eigen::Isometry3d& T_world_sweep,
@@ -21,14 +25,19 @@ class GlobalMap {
   // Centroids downsampled to voxel_size (never finer than the stored resolution), sorted by voxel key.
   std::vector<Eigen::Vector3f> points(double voxel_size) const;
   std::size_t numVoxels() const { return cells_.size(); }
+  double resolution() const { return resolution_; }
+  int coarsenings() const { return coarsenings_; }  // times the resolution doubled to stay within the bound
 
  private:
   struct Cell {
     Eigen::Vector3f sum = Eigen::Vector3f::Zero();
     std::int32_t count = 0;
   };
+  void coarsen();
   static constexpr std::int32_t kMaxSamplesPerCell = 16;
   double resolution_;
+  std::size_t max_voxels_;
+  int coarsenings_ = 0;
   std::unordered_map<VoxelKey, Cell, VoxelKeyHash> cells_;
 };
 

@@ -50,6 +50,7 @@ const ConfigTable<MapperConfig>& mapperConfigTable() {
      .add("local_map_radius_m", &M::local_map_radius_m, above(0), "m", "map points farther from the robot are dropped (bounds memory)")
      .add("global_map_resolution_m", &M::global_map_resolution_m, between(0.01, 100), "m", "resolution of the saved global map")
      .add("global_map_max_range_m", &M::global_map_max_range_m, above(0), "m", "range of the sweep points folded into the global map")
+     .add("global_map_max_voxels", &M::global_map_max_voxels, between(0, 1000000000), "voxels", "bound of the global map: beyond it its resolution doubles (0: unbounded)")
      .add("compensate_raw_sweeps", &M::compensate_raw_sweeps, anyValue(), "", "compensate raw sweeps with the odometry motion before they enter the map");
     return t;
   }();
@@ -65,7 +66,7 @@ ScanToMapMapper::ScanToMapMapper(MapperConfig config)
     : config_(std::move(config)),
       corner_map_(config_.map_voxel_size_m, config_.corner_resolution_m, config_.max_points_per_voxel),
       surf_map_(config_.map_voxel_size_m, config_.surf_resolution_m, config_.max_points_per_voxel),
-      global_map_(config_.global_map_resolution_m) {}
+      global_map_(config_.global_map_resolution_m, static_cast<std::size_t>(config_.global_map_max_voxels)) {}
 
 Correspondences ScanToMapMapper::match(const std::vector<Eigen::Vector3d>& corners,
                                        const std::vector<Eigen::Vector3d>& surfs, const Eigen::Isometry3d& T) const {
@@ -112,6 +113,7 @@ void ScanToMapMapper::addToMaps(const Sweep& s, const Eigen::Isometry3d& T) {
   surf_map_.insert(transformed(s.surf_points, T));
   corner_map_.removeFarFrom(T.translation(), config_.local_map_radius_m);
   surf_map_.removeFarFrom(T.translation(), config_.local_map_radius_m);
+  if (!keep_global_map_) return;
   std::vector<Eigen::Vector3f> cloud;
   cloud.reserve(s.cloud.size());
   for (const LidarPoint& p : s.cloud) cloud.push_back(p.p);
@@ -201,7 +203,9 @@ ScanToMapMapper::State ScanToMapMapper::state() const {
 }
 
 void ScanToMapMapper::restore(const State& s) {
+  const bool keep_global_map = keep_global_map_;
   *this = ScanToMapMapper(config_);
+  if (!keep_global_map) dropGlobalMap();
   T_map_odom_ = s.T_map_odom;
   previous_odometry_ = s.previous_odometry;
   has_previous_ = s.utime >= 0;
@@ -212,6 +216,11 @@ void ScanToMapMapper::restore(const State& s) {
 
 std::vector<Eigen::Vector3f> ScanToMapMapper::globalMap(double voxel_size) const {
   return global_map_.points(voxel_size);
+}
+
+void ScanToMapMapper::dropGlobalMap() {
+  keep_global_map_ = false;
+  global_map_ = GlobalMap(config_.global_map_resolution_m);
 }
 
 }  // namespace adit

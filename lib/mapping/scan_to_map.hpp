@@ -43,6 +43,10 @@ struct MapperConfig {
   // are sparse and noisy, hence the range limit.
   double global_map_resolution_m = 0.2;
   double global_map_max_range_m = 40.0;
+  // Bound of the global map (mapping/global_map.hpp): beyond this many voxels its resolution doubles. 1.5 M
+  // voxels (~85 MB) hold ~2.5 km of 16-beam roadway at 0.2 m. The mapper keeps no global map at all where
+  // the loop closer's map replaces it (live, and replay with the loop closer).
+  int global_map_max_voxels = 1500000;
   // Compensate sweeps that arrive raw (not deskewed) with the odometry motion before they enter the map: a
   // smeared sweep in the map misleads every later one (KITTI start-up: 0.2 m / 0.7 deg errors without).
   bool compensate_raw_sweeps = true;
@@ -73,6 +77,9 @@ class ScanToMapMapper {
 
   // The global map downsampled to voxel_size (m), deterministic order: what map.pcd holds.
   std::vector<Eigen::Vector3f> globalMap(double voxel_size) const;
+  // Stop building the global map (another stage owns the map): frees it; globalMap() is empty from then on.
+  void dropGlobalMap();
+  bool keepsGlobalMap() const { return keep_global_map_; }
 
   // What a restarted mapper needs to continue: the drift correction, the last odometry pose it saw and the
   // local map (the global map is the loop closer's job and is not part of it).
@@ -115,6 +122,7 @@ class ScanToMapMapper {
   VoxelMap corner_map_;
   VoxelMap surf_map_;
   GlobalMap global_map_;
+  bool keep_global_map_ = true;
   Eigen::Isometry3d T_map_odom_ = Eigen::Isometry3d::Identity();  // drift correction of the odometry
   bool corrected_ = false;  // a correction arrived since the last output (flag it once)
   bool has_previous_ = false;

@@ -46,6 +46,7 @@ class LoopCloserNode : public runtime::Node, public WritesProducts {
   std::vector<std::string> writeProducts(const std::string& out_dir) override {
     return writeMapProducts(closer_, uncorrected_, map_voxel_, out_dir);
   }
+  bool writesMap() const override { return true; }
 
   void useRunFolder(const runtime::RunFolder& folder) override {
     state_.setFolder(folder);

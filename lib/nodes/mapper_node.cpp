@@ -44,13 +44,19 @@ class MapperNode : public runtime::Node, public WritesProducts {
     const std::string map = (fs::path(out_dir) / "map.pcd").string();
     eval::writeTum(odometry, uncorrected_);
     eval::writeTum(trajectory, corrected_);
+    if (!mapper_.keepsGlobalMap()) return {odometry, trajectory};
     std::vector<LidarPoint> points;
     for (const auto& p : mapper_.globalMap(map_voxel_)) points.push_back({p, 0.0f, 0, 0.0f});
     io::writePcd(map, points);
     return {odometry, trajectory, map};
   }
+  bool writesMap() const override { return mapper_.keepsGlobalMap(); }
+  // The loop closer's map (corrected keyframes) replaces ours: the global map would only cost memory.
+  void mapWrittenLater() override { mapper_.dropGlobalMap(); }
 
   void useRunFolder(const runtime::RunFolder& folder) override {
+    // Live, the loop closer owns the map (save_map, the map saved on stop); this process writes none.
+    if (folder.live) mapper_.dropGlobalMap();
     state_.setFolder(folder);
     std::string error;
     if (state_.resume([this](const std::string& bytes) { return restore(bytes); }, error)) {
@@ -65,6 +71,10 @@ class MapperNode : public runtime::Node, public WritesProducts {
   }
 
   std::string state() const override { return health().counters.count("restarted") ? "restarted" : "running"; }
+
+  // Live: a sweep's time from the bus to its mapped pose, the pipeline's latency (STATUS_MAPPER counters
+  // points_to_mapped_*); the process also listens to LIDAR_POINTS for the arrival stamps.
+  LatencyProbe latencyProbe() const override { return {"points_to_mapped", "LIDAR_POINTS", "mapped"}; }
 
  protected:
   void onFinish() override {

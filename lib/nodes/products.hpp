@@ -14,6 +14,10 @@ class WritesProducts {
   virtual ~WritesProducts() = default;
   // Writes atomically into out_dir; returns the paths written.
   virtual std::vector<std::string> writeProducts(const std::string& out_dir) = 0;
+  // Whether this node's products include map.pcd; a node whose map a later one replaces is told so before
+  // the first input (mapWrittenLater) and need not build its own.
+  virtual bool writesMap() const { return false; }
+  virtual void mapWrittenLater() {}
 };
 
 }  // namespace adit::nodes

@@ -106,6 +106,14 @@ class Node {
   TimingWindow& cpuTiming() { return cpu_timing_; }
   double wallMsTotal() const { return wall_ms_total_; }
   double cpuMsTotal() const { return cpu_ms_total_; }
+  // Latency a live process measures and reports on STATUS (runtime/latency.hpp): from a message's arrival
+  // on origin_channel to this node's output on output_port with the same header.utime. Empty origin: none.
+  struct LatencyProbe {
+    std::string name;            // counter prefix on STATUS
+    std::string origin_channel;  // received for its header only (the process subscribes to it)
+    std::string output_port;
+  };
+  virtual LatencyProbe latencyProbe() const { return {}; }
   // A short word for STATUS ("running", "behind", ...); subclasses may refine it.
   virtual std::string state() const { return "running"; }
 

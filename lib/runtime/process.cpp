@@ -18,17 +18,45 @@ volatile std::sig_atomic_t g_stop = 0;  // the one process-wide flag a signal ha
 
 void onSignal(int) { g_stop = 1; }
 
+// The node's latency probe, live: the kernel's receive time of each origin message (LCM's recv_utime, wall
+// clock) against the wall time its output was published.
+class LatencyProbe {
+ public:
+  LatencyProbe(std::string name, std::string origin, std::string output)
+      : name_(std::move(name)), origin_(std::move(origin)), output_(std::move(output)) {}
+  const std::string& origin() const { return origin_; }
+  // Every adit message starts with its 8-byte fingerprint and then header.utime (big-endian int64).
+  void onOrigin(const lcm::ReceiveBuffer* rbuf, const std::string&) {
+    if (rbuf->data_size < 16) return;
+    const auto* b = static_cast<const std::uint8_t*>(rbuf->data) + 8;
+    std::uint64_t utime = 0;
+    for (int i = 0; i < 8; ++i) utime = (utime << 8) | b[i];
+    tracker_.arrived(static_cast<std::int64_t>(utime), rbuf->recv_utime);
+  }
+  void onPublished(const std::string& channel, std::int64_t utime) {
+    if (channel == output_) tracker_.completed(utime, wallUtime());
+  }
+  void report(adit::status_t& status) const { addLatencyCounters(status, name_, tracker_.summary()); }
+
+ private:
+  std::string name_, origin_, output_;
+  LatencyTracker tracker_;
+};
+
 class LcmSink : public Sink {
  public:
-  LcmSink(lcm::LCM& lcm, PublishedTraffic& traffic) : lcm_(lcm), traffic_(traffic) {}
-  void publish(const std::string& channel, const Bytes& data, std::int64_t) override {
+  LcmSink(lcm::LCM& lcm, PublishedTraffic& traffic, LatencyProbe* probe)
+      : lcm_(lcm), traffic_(traffic), probe_(probe) {}
+  void publish(const std::string& channel, const Bytes& data, std::int64_t utime) override {
     lcm_.publish(channel, data.data(), static_cast<unsigned int>(data.size()));
     traffic_.add(channel, data.size());
+    if (probe_) probe_->onPublished(channel, utime);
   }
 
  private:
   lcm::LCM& lcm_;
   PublishedTraffic& traffic_;
+  LatencyProbe* probe_;
 };
 
 // Receives raw LCM buffers and hands them to the node.
@@ -143,9 +171,13 @@ int runNodeProcess(int argc, char** argv, const std::string& name, const std::st
   }
   lcm::LCM& out = separate_out ? *separate_out : in;
   PublishedTraffic traffic;
-  LcmSink sink(out, traffic);
+  std::unique_ptr<LatencyProbe> probe;
+  if (const Node::LatencyProbe p = node->latencyProbe(); !p.origin_channel.empty() && node->channels().count(p.output_port))
+    probe = std::make_unique<LatencyProbe>(p.name, p.origin_channel, node->channels().at(p.output_port));
+  LcmSink sink(out, traffic, probe.get());
   Receiver receiver(*node, sink);
   for (const auto& channel : node->inputChannels()) in.subscribe(channel, &Receiver::onMessage, &receiver);
+  if (probe) in.subscribe(probe->origin(), &LatencyProbe::onOrigin, probe.get());
 
   installStopHandlers();
   const std::string status_channel = options.status_channel.empty() ? statusChannel(name) : options.status_channel;
@@ -166,6 +198,7 @@ int runNodeProcess(int argc, char** argv, const std::string& name, const std::st
     adit::status_t status = makeStatus(*node, wallUtime(), status_seq++,
                                        std::chrono::duration<double>(now - start).count(), rate, busy, reported);
     traffic.report(status, window);
+    if (probe) probe->report(status);
     const Bytes bytes = msg::encode(status);
     out.publish(status_channel, bytes.data(), static_cast<unsigned int>(bytes.size()));
     traffic.add(status_channel, bytes.size());

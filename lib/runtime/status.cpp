@@ -1,6 +1,8 @@
 #include "runtime/status.hpp"
 
 #include <cctype>
+#include <cmath>
+#include <utility>
 
 namespace adit::runtime {
 
@@ -63,6 +65,18 @@ adit::status_t makeStatus(const std::string& process, const Health& health, cons
 adit::status_t makeStatus(const Node& node, std::int64_t wall_utime, std::int64_t seq, double uptime_s,
                           double rate_hz, double busy, const std::string& state) {
   return makeStatus(node.name(), node.health(), node.timing(), wall_utime, seq, uptime_s, rate_hz, busy, state);
+}
+
+void addLatencyCounters(adit::status_t& status, const std::string& name, const LatencySummary& latency) {
+  const auto us = [](double ms) { return static_cast<std::int64_t>(std::llround(ms * 1e3)); };
+  const std::pair<const char*, std::int64_t> fields[] = {
+      {"_p50_us", us(latency.p50_ms)}, {"_p95_us", us(latency.p95_ms)}, {"_p99_us", us(latency.p99_ms)},
+      {"_max_us", us(latency.max_ms)}, {"_samples", latency.samples},   {"_unmatched", latency.unmatched}};
+  for (const auto& [suffix, value] : fields) {
+    status.counter_names.push_back(name + suffix);
+    status.counter_values.push_back(value);
+  }
+  status.num_counters = static_cast<std::int32_t>(status.counter_names.size());
 }
 
 }  // namespace adit::runtime

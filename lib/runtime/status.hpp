@@ -1,6 +1,7 @@
 // Builds the STATUS message of a node.
 #pragma once
 
+#include "runtime/latency.hpp"
 #include "runtime/node.hpp"
 
 #include <adit/status_t.hpp>
@@ -38,5 +39,9 @@ adit::status_t makeStatus(const Node& node, std::int64_t wall_utime, std::int64_
 adit::status_t makeStatus(const std::string& process, const Health& health, const TimingWindow& timing,
                           std::int64_t wall_utime, std::int64_t seq, double uptime_s, double rate_hz,
                           double busy, const std::string& state);
+
+// Appends a latency summary to status's named counters, in microseconds: "<name>_p50_us", "_p95_us",
+// "_p99_us", "_max_us", and "<name>_samples" (sweeps in the window), "<name>_unmatched" (never completed).
+void addLatencyCounters(adit::status_t& status, const std::string& name, const LatencySummary& latency);
 
 }  // namespace adit::runtime

@@ -1,7 +1,8 @@
 // adit bench ablation <log> --gt <gt>: the paper's before/after comparison on one log, same binaries:
 //   (a) plain A-LOAM, (b) + LinK3D, (c) + LinK3D + Scan Context loop closure; one APE table.
 // adit bench pipeline [--sensor vlp16|hdl64] [--log LOG] [--json FILE]: per-stage wall and CPU ms per sweep
-//   (median, p95), throughput, real-time factor and peak memory of the whole pipeline.
+//   (median, p95), throughput, real-time factor and peak memory of the whole pipeline. With --live: the real
+//   processes in real time over UDP (private network namespace), LIDAR_POINTS -> ODOM_MAPPED latency.
 // adit bench compare a.json b.json [--tolerance PCT]: one line per figure with its change; regressions flagged.
 #include "commands.hpp"
 
@@ -9,13 +10,16 @@
 #include "eval/trajectory_io.hpp"
 #include "io/atomic_file.hpp"
 #include "pipeline/bench_figures.hpp"
+#include "pipeline/live_status.hpp"
 #include "pipeline/run_summary.hpp"
 #include "runtime/process.hpp"
 #include "sources/sim_source.hpp"
 
 #include <fmt/format.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 
@@ -82,12 +86,67 @@ void registerAblation(CLI::App& bench) {
   });
 }
 
+struct PipelineBenchArgs {
+  std::string sensor = "vlp16", log, world = "roadway-loop", json;
+  std::vector<std::string> configs;
+  double duration_s = 60;
+  bool live = false;
+};
+
+std::string shellQuoted(const std::string& s) {
+  std::string out = "'";
+  for (char c : s) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return out + "'";
+}
+
+// `adit bench pipeline --live`: launch/sim.launch.yaml (the simulator in real time and the four stage
+// processes over UDP multicast) inside a private network namespace, recording STATUS only; the figures are
+// what the processes' last STATUS said, the mapper's LIDAR_POINTS -> ODOM_MAPPED latency first.
+int runLiveBench(const PipelineBenchArgs& a) {
+  const fs::path root = aditRoot();
+  const std::string self = (fs::path(executableDir()) / "adit").string();
+  if (std::getenv("ADIT_IN_NETNS") == nullptr) {  // re-run inside the namespace (exit 77: none can be made)
+    std::string command = "bash " + shellQuoted((root / "tests" / "integration" / "netns.sh").string()) + " " +
+                          shellQuoted(self) + " bench pipeline --live --world " + shellQuoted(a.world) +
+                          " --sensor " + shellQuoted(a.sensor) + fmt::format(" --duration {}", a.duration_s);
+    for (const auto& c : a.configs) command += " --config " + shellQuoted(c);
+    if (!a.json.empty()) command += " --json " + shellQuoted(fs::absolute(a.json).string());
+    const int status = std::system(command.c_str());
+    return WIFEXITED(status) ? WEXITSTATUS(status) : 1;
+  }
+  if (!a.configs.empty()) fmt::print("  note: --live runs launch/sim.launch.yaml with its own configuration; --config is ignored\n");
+  const fs::path work = fs::temp_directory_path() / ("adit_bench_live_" + std::to_string(::getpid()));
+  fs::create_directories(work);
+  fmt::print("live pipeline benchmark: {} {} for {:.0f} s in real time, real processes over UDP ...\n", a.world, a.sensor,
+             a.duration_s);
+  std::fflush(stdout);
+  const std::string command = shellQuoted(self) + " launch " + shellQuoted((root / "launch" / "sim.launch.yaml").string()) +
+                              " --set WORLD=" + shellQuoted(a.world) + " --set SENSOR=" + shellQuoted(a.sensor) +
+                              fmt::format(" --set DURATION={}", a.duration_s) + " --set RECORD='^STATUS_.*$'" +
+                              " --log-dir " + shellQuoted(work.string()) + " --quiet";
+  const int status = std::system(command.c_str());
+  std::map<std::string, adit::status_t> last;
+  for (const auto& entry : fs::recursive_directory_iterator(work)) {
+    const std::string name = entry.path().filename().string();
+    if (name.rfind("record", 0) != 0 || entry.path().extension() != ".lcmlog") continue;
+    for (auto& [process, s] : adit::pipeline::lastStatusByProcess(entry.path().string())) last[process] = std::move(s);
+  }
+  fs::remove_all(work);
+  if (last.empty()) {
+    fmt::print(stderr, "error adit: the live run recorded no STATUS (adit launch exit status {})\n", status);
+    return 1;
+  }
+  const auto figures = adit::pipeline::liveFigures(last);
+  for (const auto& f : figures) fmt::print("  {:<36} {:>10.2f} {}\n", f.name, f.value, f.unit);
+  if (!a.json.empty()) {
+    adit::io::writeFileAtomically(a.json, adit::pipeline::benchFiguresJson(figures, "live " + a.world + " " + a.sensor));
+    fmt::print("  figures written to {}\n", a.json);
+  }
+  return 0;
+}
+
 void registerPipelineBench(CLI::App& bench) {
-  struct Args {
-    std::string sensor = "vlp16", log, world = "roadway-loop", json;
-    std::vector<std::string> configs;
-    double duration_s = 60;
-  };
+  using Args = PipelineBenchArgs;
   auto a = std::make_shared<Args>();
   auto* cmd = bench.add_subcommand("pipeline", "Time every stage over a simulated run (or a log): ms per sweep, throughput, memory");
   cmd->add_option("--sensor", a->sensor, "Simulated sensor: vlp16 | rs16 | hdl64")->check(CLI::IsMember({"vlp16", "rs16", "hdl64"}));
@@ -96,7 +155,14 @@ void registerPipelineBench(CLI::App& bench) {
   cmd->add_option("--log", a->log, "Time this log instead of a simulation")->check(CLI::ExistingFile);
   cmd->add_option("--config", a->configs, "Configuration (default launch/config/pipeline.yaml)");
   cmd->add_option("--json", a->json, "Also write the figures to this JSON file (for adit bench compare)");
+  cmd->add_flag("--live", a->live, "Run the real processes in real time over UDP in a private network namespace "
+                                   "and report the LIDAR_POINTS -> ODOM_MAPPED latency from their STATUS");
   cmd->callback([a] {
+    if (a->live) {
+      if (!a->log.empty()) throw CLI::ValidationError("--live", "simulates in real time; it takes no --log");
+      if (const int code = runLiveBench(*a); code != 0) throw CLI::RuntimeError(code);
+      return;
+    }
     const fs::path root = aditRoot();
     std::vector<std::string> configs = a->configs;
     if (configs.empty()) configs.push_back((root / "launch" / "config" / "pipeline.yaml").string());

@@ -1,7 +1,9 @@
 // Loop-closure speed: Scan Context build + candidate search with 5,000 keyframes in the database (target
 // <= 2 ms), and optimisation of a 5,000-node pose graph with 20 loops (target < 1 s).
 #include "box_world.hpp"
+#include "loop/compact_cloud.hpp"
 #include "loop/pose_graph.hpp"
+#include "loop/voxel_filter.hpp"
 #include "loop/scan_context_database.hpp"
 
 #include <benchmark/benchmark.h>
@@ -91,6 +93,28 @@ void BM_PoseGraph5000Nodes20Loops(benchmark::State& state) {
   state.counters["solved"] = report.solved ? 1 : 0;
 }
 BENCHMARK(BM_PoseGraph5000Nodes20Loops)->Unit(benchmark::kMillisecond);
+
+// A keyframe's cloud (a simulated 16-beam sweep thinned to 0.2 m) quantised and decoded: what keeping the
+// keyframe clouds compact costs per keyframe, and per cloud a loop job decodes.
+std::vector<Eigen::Vector3f> keyframeCloud() {
+  const auto sweep = adit::testing::positions(adit::testing::simulateSweep(
+      adit::testing::makeRoadway(7, 4.57, 12, false), adit::testing::poseXYYaw(0.3, 0.1, 1.8, 1.0), 99));
+  return voxelDownsample(sweep, 0.2);
+}
+
+void BM_KeyframeCloudEncode(benchmark::State& state) {
+  const auto cloud = keyframeCloud();
+  for (auto _ : state) benchmark::DoNotOptimize(CompactCloud::encode(cloud, 0.005f));
+  state.counters["points"] = static_cast<double>(cloud.size());
+}
+BENCHMARK(BM_KeyframeCloudEncode)->Unit(benchmark::kMicrosecond);
+
+void BM_KeyframeCloudDecode(benchmark::State& state) {
+  const CompactCloud compact = CompactCloud::encode(keyframeCloud(), 0.005f);
+  for (auto _ : state) benchmark::DoNotOptimize(compact.decode());
+  state.counters["points"] = static_cast<double>(compact.size());
+}
+BENCHMARK(BM_KeyframeCloudDecode)->Unit(benchmark::kMicrosecond);
 
 }  // namespace
 

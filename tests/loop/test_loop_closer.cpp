@@ -2,6 +2,7 @@
 // ATE halved), a periodic roadway (aliasing rejected), and the degeneracy check of the verifier.
 #include "box_world.hpp"
 #include "loop/loop_closer.hpp"
+#include "loop/voxel_filter.hpp"
 
 #include <gtest/gtest.h>
 
@@ -253,3 +254,21 @@ TEST(LoopCloser, ConfigReadsDottedKeys) {
   EXPECT_EQ(k.min_consistent_loops, 1);
   EXPECT_DOUBLE_EQ(k.keyframe_distance, 1.0);
 }
+
+namespace adit {
+namespace {
+
+TEST(VoxelAccumulator, SameCentroidsAsDownsamplingAllPointsAtOnce) {
+  std::vector<Eigen::Vector3f> points;
+  VoxelAccumulator grid(0.3);
+  for (int i = 0; i < 20000; ++i) {
+    const float t = static_cast<float>(i) * 0.37f;
+    points.emplace_back(std::fmod(t, 23.0f) - 11.0f, std::sin(t) * 4.0f, std::cos(t * 0.7f) * 2.0f);
+    grid.add(points.back());
+  }
+  grid.add(Eigen::Vector3f(std::nanf(""), 0.0f, 0.0f));
+  EXPECT_EQ(grid.centroids(), voxelDownsample(points, 0.3));
+}
+
+}  // namespace
+}  // namespace adit

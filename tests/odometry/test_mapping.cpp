@@ -110,3 +110,66 @@ TEST(Mapper, GlobalMapIsDownsampledAndDeterministic) {
 
 }  // namespace
 }  // namespace adit
+
+namespace adit {
+namespace {
+
+// Points on the walls and floor of a straight 4 m wide, 3 m high roadway from x0 to x1, 5 cm apart.
+std::vector<Eigen::Vector3f> roadwaySurface(float x0, float x1) {
+  std::vector<Eigen::Vector3f> points;
+  for (float x = x0; x < x1; x += 0.05f)
+    for (float s = 0.0f; s < 3.0f; s += 0.05f) {
+      points.emplace_back(x, -2.0f, s);
+      points.emplace_back(x, 2.0f, s);
+      points.emplace_back(x, s - 1.5f, 0.0f);
+    }
+  return points;
+}
+
+TEST(GlobalMap, StaysWithinItsBoundAndKeepsTheWholeExtent) {
+  constexpr std::size_t kMaxVoxels = 4000;
+  GlobalMap bounded(0.2, kMaxVoxels), unbounded(0.2);
+  // 60 m of roadway, one 2 m piece per "sweep" given in a frame 1 m behind it: ~4x the bound at 0.2 m.
+  for (int i = 0; i < 30; ++i) {
+    const auto piece = roadwaySurface(1.0f, 3.0f);
+    const Eigen::Isometry3d T(Eigen::Translation3d(2.0 * i - 1.0, 0.0, 0.0));
+    bounded.insert(piece, T, 100.0);
+    unbounded.insert(piece, T, 100.0);
+    ASSERT_LE(bounded.numVoxels(), kMaxVoxels) << "after sweep " << i;
+  }
+  EXPECT_GT(unbounded.numVoxels(), 3 * kMaxVoxels) << "the test must feed more than the bound holds";
+  EXPECT_GE(bounded.coarsenings(), 1);
+  EXPECT_DOUBLE_EQ(bounded.resolution(), 0.2 * std::pow(2.0, bounded.coarsenings()));
+  // Coarser, not cut: the map still spans the whole roadway, and every centroid lies on a true surface.
+  const auto points = bounded.points(0.0);
+  ASSERT_FALSE(points.empty());
+  float min_x = 1e9f, max_x = -1e9f;
+  for (const Eigen::Vector3f& p : points) {
+    min_x = std::min(min_x, p.x());
+    max_x = std::max(max_x, p.x());
+    const float to_wall = std::abs(std::abs(p.y()) - 2.0f), to_floor = std::abs(p.z());
+    EXPECT_LT(std::min(to_wall, to_floor), static_cast<float>(bounded.resolution())) << p.transpose();
+  }
+  EXPECT_LT(min_x, 0.5f);
+  EXPECT_GT(max_x, 59.5f);
+  // Deterministic: the same input gives the same points.
+  GlobalMap again(0.2, kMaxVoxels);
+  for (int i = 0; i < 30; ++i)
+    again.insert(roadwaySurface(1.0f, 3.0f), Eigen::Isometry3d(Eigen::Translation3d(2.0 * i - 1.0, 0.0, 0.0)), 100.0);
+  EXPECT_EQ(again.points(0.0), points);
+}
+
+TEST(GlobalMap, DroppedWhenAnotherStageOwnsTheMap) {
+  ScanToMapMapper mapper;
+  mapper.dropGlobalMap();
+  drive(mapper, 3, 0.5);
+  EXPECT_FALSE(mapper.keepsGlobalMap());
+  EXPECT_TRUE(mapper.globalMap(0.1).empty());
+  ScanToMapMapper restored;
+  restored.dropGlobalMap();
+  restored.restore(mapper.state());
+  EXPECT_FALSE(restored.keepsGlobalMap()) << "a restored mapper must not start building it again";
+}
+
+}  // namespace
+}  // namespace adit
