@@ -42,12 +42,12 @@ Config pipelineConfig() {
   return runtime::loadConfig({(launch / "config" / "pipeline.yaml").string(), (launch / "sensors" / "sim.yaml").string()});
 }
 
-struct Run {
+struct ReplayRun {
   double ape_rmse_m = 0;
   std::int64_t sweeps = 0;
 };
 
-Run replay(std::vector<runtime::OutgoingMessage> messages, const Trajectory& truth, const std::string& tag) {
+ReplayRun replay(std::vector<runtime::OutgoingMessage> messages, const Trajectory& truth, const std::string& tag) {
   VectorSource source(std::move(messages));
   pipeline::ReplayOptions options;
   options.source = &source;
@@ -55,7 +55,7 @@ Run replay(std::vector<runtime::OutgoingMessage> messages, const Trajectory& tru
   options.config = pipelineConfig();
   options.record = "";
   const pipeline::ReplayReport report = pipeline::runReplay(options);
-  Run run;
+  ReplayRun run;
   run.sweeps = report.sweeps;
   const eval::EvalResult r = eval::evaluate(truth, eval::readTum(options.out_dir + "/trajectory.tum"));
   EXPECT_TRUE(r.valid) << r.message;
@@ -96,8 +96,8 @@ TEST(PcapReplay, SameAccuracyAsTheSimulatorsLog) {
   std::stable_sort(from_pcap.begin(), from_pcap.end(),
                    [](const auto& a, const auto& b) { return a.utime < b.utime; });
 
-  const Run log_run = replay(logged, source.groundTruth(), "log");
-  const Run pcap_run = replay(from_pcap, source.groundTruth(), "pcap");
+  const ReplayRun log_run = replay(logged, source.groundTruth(), "log");
+  const ReplayRun pcap_run = replay(from_pcap, source.groundTruth(), "pcap");
   std::printf("%lld packets; sweeps: log %lld, pcap %lld; APE rmse: log %.4f m, pcap %.4f m (%+.1f %%)\n",
               static_cast<long long>(packets), static_cast<long long>(log_run.sweeps),
               static_cast<long long>(pcap_run.sweeps), log_run.ape_rmse_m, pcap_run.ape_rmse_m,
