@@ -35,6 +35,7 @@ struct LidarScan {
   bool has_ring = false;       // ring holds real beam indices
   bool has_time = false;       // dt holds real per-point times
   bool deskewed = false;       // points are compensated to utime
+  bool partial = false;        // less than a revolution: the last one of a recording, published at its end
   std::vector<LidarPoint> points;
 };
 

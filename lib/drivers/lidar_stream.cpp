@@ -31,17 +31,53 @@ bool worthLogging(std::int64_t n) {
 }  // namespace
 
 LidarPacketStream::LidarPacketStream(const LidarStreamConfig& config)
-    : sensor_time_(config.clock.source == TimeSource::kSensor), clock_(config.clock), assembler_(config.sweep) {
-  const std::array<double, kBeams> elevations = elevationTable(config);
+    : config_(config),
+      sensor_time_(config.clock.source == TimeSource::kSensor),
+      host_time_fallback_(config.host_time_fallback),
+      clock_config_(config.clock),
+      clock_(config.clock),
+      assembler_(config.sweep) {
+  for (int id : config.accept_product_ids)
+    if (id < 0 || id > 255) throw std::invalid_argument("lidar driver: product id " + std::to_string(id) + " is not a byte");
+  makeDecoder(elevationTable(config), config.dual_return);
+}
+
+void LidarPacketStream::makeDecoder(const std::array<double, kBeams>& elevations, bool dual_return) {
+  elevations_ = elevations;
+  dual_return_ = dual_return;
   firing_table_ = drivers::firingTable(BeamTable::fromElevationsDeg(elevations),
-                                       config.model == LidarModel::kVlp16 ? kVlp16FiringNs : kRs16FiringNs);
-  if (config.model == LidarModel::kVlp16) {
-    auto decoder = std::make_shared<Vlp16Decoder>(elevations);
+                                       config_.model == LidarModel::kVlp16 ? kVlp16FiringNs : kRs16FiringNs);
+  if (config_.model == LidarModel::kVlp16) {
+    std::vector<std::uint8_t> products;
+    for (int id : config_.accept_product_ids) products.push_back(static_cast<std::uint8_t>(id));
+    auto decoder = std::make_shared<Vlp16Decoder>(elevations, products);
     decode_ = [decoder](const std::uint8_t* d, std::size_t n, DecodedPacket& out) { return decoder->decode(d, n, out); };
   } else {
-    auto decoder = std::make_shared<Rs16Decoder>(elevations);
+    auto decoder = std::make_shared<Rs16Decoder>(elevations, dual_return);
     decode_ = [decoder](const std::uint8_t* d, std::size_t n, DecodedPacket& out) { return decoder->decode(d, n, out); };
   }
+}
+
+void LidarPacketStream::pushDeviceInfo(const std::uint8_t* data, std::size_t size) {
+  Rs16Difop difop;
+  if (config_.model != LidarModel::kRs16 || !parseRs16Difop(data, size, difop)) {
+    health_.counters["bad_difop"] += 1;
+    return;
+  }
+  health_.counters["difop"] += 1;
+  // A table given in the configuration is the user's calibration and wins over the sensor's.
+  const std::array<double, kBeams> elevations =
+      difop.has_angles && config_.elevations_deg.empty() ? difop.elevation_deg : elevations_;
+  if (elevations == elevations_ && difop.dual_return == dual_return_) return;
+  try {
+    makeDecoder(elevations, difop.dual_return);
+  } catch (const std::invalid_argument&) {  // an angle table BeamTable refuses
+    health_.counters["bad_difop"] += 1;
+    return;
+  }
+  health_.counters["difop_applied"] += 1;
+  spdlog::info("RS-16 DIFOP: {} return{}", difop.dual_return ? "dual" : "single",
+               difop.has_angles ? ", calibrated vertical angles" : "");
 }
 
 void LidarPacketStream::count(const std::string& counter, std::int64_t& total, const std::string& what) {
@@ -53,8 +89,20 @@ void LidarPacketStream::count(const std::string& counter, std::int64_t& total, c
 
 void LidarPacketStream::push(const std::uint8_t* data, std::size_t size, std::int64_t host_receive_ns,
                              std::vector<LidarScan>& sweeps) {
+  if (config_.model == LidarModel::kRs16 && size >= kRs16DifopMagic.size() &&
+      std::equal(kRs16DifopMagic.begin(), kRs16DifopMagic.end(), data)) {
+    pushDeviceInfo(data, size);
+    return;
+  }
   ++health_.inputs;
   PacketStatus status = decode_(data, size, packet_);
+  if (status == PacketStatus::kOk && !packet_.stamp_valid && sensor_time_ && host_time_fallback_ && !placed_any_) {
+    sensor_time_ = false;
+    clock_config_.source = TimeSource::kHost;
+    clock_ = PacketClock(clock_config_);
+    health_.counters["host_time_fallback"] = 1;
+    spdlog::warn("lidar packets carry no usable sensor time: using the receive (capture) times");
+  }
   if (status == PacketStatus::kOk && !packet_.stamp_valid && sensor_time_) status = PacketStatus::kBadTimestamp;
   if (status != PacketStatus::kOk) {
     count(counterName(status), health_.errors,
@@ -71,9 +119,17 @@ void LidarPacketStream::push(const std::uint8_t* data, std::size_t size, std::in
     spdlog::warn("lidar clock jumped (packet stamp {} us): re-anchored on the host clock", packet_.stamp_us);
   }
   if (t->shifted) health_.counters["time_shifted"] += 1;
+  placed_any_ = true;
   health_.last_input_utime = t->first_firing_ns / 1000;
   const std::size_t before = sweeps.size();
   assembler_.add(packet_, t->first_firing_ns, sweeps);
+  health_.outputs += static_cast<std::int64_t>(sweeps.size() - before);
+  syncSweepCounters();
+}
+
+void LidarPacketStream::finish(std::vector<LidarScan>& sweeps) {
+  const std::size_t before = sweeps.size();
+  assembler_.flush(sweeps);
   health_.outputs += static_cast<std::int64_t>(sweeps.size() - before);
   syncSweepCounters();
 }
@@ -86,6 +142,7 @@ void LidarPacketStream::syncSweepCounters() {
   c["sweep_too_long"] = s.too_long;
   c["packet_gap"] = s.gaps;
   c["empty_sweep"] = s.empty;
+  if (s.flushed > 0) c["partial_sweep_published"] = s.flushed;
   health_.drops += s.partial + s.too_long - dropped_before;
 }
 

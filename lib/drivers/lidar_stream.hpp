@@ -11,6 +11,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <array>
 #include <functional>
 #include <string>
 #include <vector>
@@ -26,6 +27,15 @@ struct LidarStreamConfig {
   std::vector<double> elevations_deg;
   PacketClockConfig clock;
   SweepAssemblerConfig sweep;
+  // Sensor time only: if the first decodable packet's stamp is unusable (an RS-16 whose clock was never
+  // set), run on the receive times instead (counter host_time_fallback). Recordings turn it on: their
+  // capture times are the only other clock; live, a bad sensor clock is reported instead.
+  bool host_time_fallback = false;
+  // VLP-16: product ids (factory byte 1205) accepted besides 0x22 (VLP-16) and 0 (old firmware), for units
+  // that announce another product but send VLP-16 packets (lidar_driver.accept_product_ids).
+  std::vector<int> accept_product_ids;
+  // RS-16: the return mode until a DIFOP packet says otherwise.
+  bool dual_return = false;
 };
 
 // Counter names in Health::counters:
@@ -33,7 +43,7 @@ struct LidarStreamConfig {
 //     unknown_product, unknown_return_mode;
 //   skipped packets (Health::drops): time_backwards;
 //   sweeps not published (Health::drops): partial_sweep, sweep_too_long;
-//   events: packet_gap, time_reanchor, time_shifted, empty_sweep.
+//   events: packet_gap, time_reanchor, time_shifted, empty_sweep, partial_sweep_published.
 class LidarPacketStream {
  public:
   // Throws std::invalid_argument on a bad elevation table.
@@ -42,6 +52,15 @@ class LidarPacketStream {
   // One UDP payload that arrived at host_receive_ns (ns since 1970). Finished sweeps are appended to `sweeps`.
   void push(const std::uint8_t* data, std::size_t size, std::int64_t host_receive_ns,
             std::vector<LidarScan>& sweeps);
+
+  // RS-16 DIFOP packet (port 7788; also recognised by its header on the data port): its return mode, and its
+  // vertical-angle calibration unless the config gave a table, replace what the decoder used (counters
+  // difop, difop_applied). Anything else is counted as bad_difop.
+  void pushDeviceInfo(const std::uint8_t* data, std::size_t size);
+
+  // End of the packets (a recording's end): the sweep in progress is appended, flagged partial
+  // (counter partial_sweep_published).
+  void finish(std::vector<LidarScan>& sweeps);
 
   // inputs = packets, outputs = sweeps published.
   const runtime::Health& health() const { return health_; }
@@ -52,8 +71,16 @@ class LidarPacketStream {
   void count(const std::string& counter, std::int64_t& total, const std::string& what);
   void syncSweepCounters();
 
+  void makeDecoder(const std::array<double, kBeams>& elevations, bool dual_return);
+
+  LidarStreamConfig config_;
+  std::array<double, kBeams> elevations_{};
+  bool dual_return_ = false;
   std::function<PacketStatus(const std::uint8_t*, std::size_t, DecodedPacket&)> decode_;
   bool sensor_time_;
+  bool host_time_fallback_;
+  bool placed_any_ = false;
+  PacketClockConfig clock_config_;
   PacketClock clock_;
   SweepAssembler assembler_;
   DecodedPacket packet_;  // reused between packets

@@ -39,8 +39,28 @@ std::int64_t utcMicros(int year, int month, int day, int hour, int minute, int s
   return seconds * 1000000 + micros;
 }
 
-Rs16Decoder::Rs16Decoder(const std::array<double, kBeams>& elevation_deg)
-    : beams_(BeamTable::fromElevationsDeg(elevation_deg)) {}
+Rs16Decoder::Rs16Decoder(const std::array<double, kBeams>& elevation_deg, bool dual_return)
+    : beams_(BeamTable::fromElevationsDeg(elevation_deg)), dual_return_(dual_return) {}
+
+bool parseRs16Difop(const std::uint8_t* data, std::size_t size, Rs16Difop& out) {
+  if (data == nullptr || size != kRs16PacketSize || !std::equal(kRs16DifopMagic.begin(), kRs16DifopMagic.end(), data))
+    return false;
+  out = Rs16Difop{};
+  out.dual_return = data[300] == 0;
+  constexpr std::size_t kAngles = 1165;
+  bool blank_zero = true, blank_ff = true, in_range = true;
+  for (int i = 0; i < kBeams; ++i) {
+    const std::uint8_t* v = data + kAngles + static_cast<std::size_t>(i) * 3;
+    const std::uint32_t millideg = (static_cast<std::uint32_t>(v[0]) << 16) | (static_cast<std::uint32_t>(v[1]) << 8) | v[2];
+    blank_zero = blank_zero && millideg == 0;
+    blank_ff = blank_ff && millideg == 0xFFFFFF;
+    const double deg = millideg * 0.001;
+    in_range = in_range && deg <= 25.0;  // the head's field of view is +-15 deg
+    out.elevation_deg[static_cast<std::size_t>(i)] = i < 8 ? -deg : deg;
+  }
+  out.has_angles = !blank_zero && !blank_ff && in_range;
+  return true;
+}
 
 PacketStatus Rs16Decoder::decode(const std::uint8_t* data, std::size_t size, DecodedPacket& out) const {
   resetPacket(out, SensorClock::kUtcMicros);
@@ -58,8 +78,15 @@ PacketStatus Rs16Decoder::decode(const std::uint8_t* data, std::size_t size, Dec
   }
   out.stamp_us = stamp;
   out.stamp_valid = stamp_valid;
-
+  out.dual_return = dual_return_;
   out.firings.reserve(static_cast<std::size_t>(kBlocks * 2 * kBeams));
+  if (dual_return_) decodeDual(blocks, azimuth, out);
+  else decodeSingle(blocks, azimuth, out);
+  out.duration_ns = out.firings.back().offset_ns;
+  return PacketStatus::kOk;
+}
+
+void Rs16Decoder::decodeSingle(const std::uint8_t* blocks, const std::uint16_t* azimuth, DecodedPacket& out) const {
   for (int b = 0; b < kBlocks; ++b) {
     const int from = b + 1 < kBlocks ? b : b - 1;
     double gap = wrapAzimuthCentiDeg(static_cast<double>(azimuth[from + 1]) - azimuth[from]);
@@ -82,8 +109,33 @@ PacketStatus Rs16Decoder::decode(const std::uint8_t* data, std::size_t size, Dec
       }
     }
   }
-  out.duration_ns = out.firings.back().offset_ns;
-  return PacketStatus::kOk;
+}
+
+void Rs16Decoder::decodeDual(const std::uint8_t* blocks, const std::uint16_t* azimuth, DecodedPacket& out) const {
+  for (int b = 0; b < kBlocks; ++b) {
+    const int from = b + 1 < kBlocks ? b : b - 1;
+    double gap = wrapAzimuthCentiDeg(static_cast<double>(azimuth[from + 1]) - azimuth[from]);
+    if (gap > kMaxBlockGapCentiDeg) gap = 0.0;
+    for (int laser = 0; laser < kBeams; ++laser) {
+      const std::int64_t in_block_ns = laser * kRs16FiringNs;
+      const double az = wrapAzimuthCentiDeg(azimuth[b] + gap * static_cast<double>(in_block_ns) /
+                                                             static_cast<double>(kRs16SequenceNs)) * 0.01;
+      std::uint16_t first_raw = 0;
+      for (int r = 0; r < 2; ++r) {
+        const std::uint8_t* point = blocks + b * kBlockBytes + 4 + static_cast<std::size_t>(r * kBeams + laser) * 3;
+        const std::uint16_t raw = readBe16(point);
+        if (r == 0) first_raw = raw;
+        Firing f;
+        f.offset_ns = b * kRs16SequenceNs + in_block_ns;
+        f.azimuth_deg = static_cast<float>(az);
+        f.ring = beams_.ring[laser];
+        f.intensity = point[2];
+        f.has_return = raw != 0 && !(r == 1 && raw == first_raw);
+        if (f.has_return) f.p = beams_.point(raw * kRs16DistanceUnitM, az, laser);
+        out.firings.push_back(f);
+      }
+    }
+  }
 }
 
 }  // namespace adit::drivers

@@ -55,7 +55,21 @@ void SweepAssembler::finishSweep(std::vector<LidarScan>& sweeps) {
     ++stats_.too_long;
     return;
   }
+  publish(false, sweeps);
+}
+
+void SweepAssembler::flush(std::vector<LidarScan>& sweeps) {
+  if (!started_ || points_.empty()) return;
+  ++stats_.flushed;
+  publish(true, sweeps);
+  points_.clear();
+  complete_ = false;
+  started_ = false;
+}
+
+void SweepAssembler::publish(bool partial, std::vector<LidarScan>& sweeps) {
   LidarScan scan;
+  scan.partial = partial;
   scan.utime = last_ns_ / 1000;  // dt below is exact to the ns; utime is that instant's microsecond
   scan.seq = stats_.sweeps++;
   scan.sensor = config_.sensor;

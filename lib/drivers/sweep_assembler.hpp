@@ -38,6 +38,7 @@ struct SweepStats {
   std::int64_t too_long = 0;        // dropped: longer than max_sweep_duration_s
   std::int64_t gaps = 0;            // firing gaps longer than max_firing_gap_s
   std::int64_t empty = 0;           // published with no point (every firing without return)
+  std::int64_t flushed = 0;         // published partial at the end of the stream
 };
 
 class SweepAssembler {
@@ -48,6 +49,10 @@ class SweepAssembler {
   // appended to `sweeps`. Packets must come in time order (PacketClock guarantees it).
   void add(const DecodedPacket& packet, std::int64_t first_firing_ns, std::vector<LidarScan>& sweeps);
 
+  // End of the stream (a recording's end): the sweep in progress, if it holds a point, is appended flagged
+  // `partial` (whether or not it began at a cut), so a recording's last firings are not lost.
+  void flush(std::vector<LidarScan>& sweeps);
+
   const SweepStats& stats() const { return stats_; }
 
  private:
@@ -57,6 +62,7 @@ class SweepAssembler {
   };
   void addFiring(const Firing& f, std::int64_t t_ns, std::vector<LidarScan>& sweeps);
   void finishSweep(std::vector<LidarScan>& sweeps);
+  void publish(bool partial, std::vector<LidarScan>& sweeps);
   void restart(bool complete, std::int64_t t_ns);
 
   SweepAssemblerConfig config_;

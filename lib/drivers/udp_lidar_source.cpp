@@ -119,6 +119,10 @@ UdpLidarConfig udpLidarConfigFrom(const Config& c) {
   d.max_firing_gap_s = c.get(k + "max_firing_gap_s", d.max_firing_gap_s);
   d.vertical_angles_deg = c.getList<double>(k + "vertical_angles_deg", d.vertical_angles_deg);
   d.idle_timeout_s = c.get(k + "idle_timeout_s", d.idle_timeout_s);
+  d.sensor_address = c.get(k + "sensor_address", d.sensor_address);
+  d.accept_product_ids = c.getList<int>(k + "accept_product_ids", d.accept_product_ids);
+  d.dual_return = c.get(k + "dual_return", d.dual_return);
+  d.difop_port = c.get(k + "difop_port", d.difop_port);
   return d;
 }
 
@@ -149,6 +153,8 @@ LidarStreamConfig streamConfigOf(const UdpLidarConfig& config) {
   s.sweep.max_firing_gap_s = config.max_firing_gap_s;
   s.sweep.sensor = config.sensor_name.empty() ? config.model : config.sensor_name;
   s.sweep.num_beams = kBeams;
+  s.accept_product_ids = config.accept_product_ids;
+  s.dual_return = config.dual_return;
   return s;
 }
 

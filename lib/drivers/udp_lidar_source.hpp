@@ -44,6 +44,19 @@ struct UdpLidarConfig {
   // lidar_driver.vertical_angles_deg: 16 elevations (deg) by laser id in packet order, e.g. an RS-16's
   // DIFOP calibration; empty = the model's nominal table.
   std::vector<double> vertical_angles_deg;
+  // lidar_driver.accept_product_ids: VLP-16 only: factory product ids (byte 1205, decimal) to decode as
+  // VLP-16 packets besides 34 (0x22, VLP-16) and 0 (firmware before 3.0.29). Some units in the field announce
+  // another product (e.g. 36 = 0x24, Puck Hi-Res) while sending VLP-16 packets; without this every packet
+  // of such a unit is dropped as unknown_product.
+  std::vector<int> accept_product_ids;
+  // lidar_driver.dual_return: RS-16 only: decode dual-return packets from the start (a DIFOP packet, if the
+  // recording or the network holds one, says which mode the sensor is in and overrides this).
+  bool dual_return = false;
+  // lidar_driver.difop_port: RS-16 only: the port of the DIFOP packets (recordings; 0 = 7788).
+  int difop_port = 0;
+  // lidar_driver.sensor_address: recordings (pcap): only datagrams from this IPv4 address are the sensor's;
+  // "" = the first host that sends a valid packet to the data port.
+  std::string sensor_address;
   // lidar_driver.idle_timeout_s: next() reports the end after this long without a packet (s); 0 = wait
   // for the sensor forever (stops only on SIGINT/SIGTERM).
   double idle_timeout_s = 0.0;

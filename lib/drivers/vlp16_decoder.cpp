@@ -2,6 +2,8 @@
 
 #include "drivers/packet_bytes.hpp"
 
+#include <algorithm>
+
 namespace adit::drivers {
 namespace {
 
@@ -17,14 +19,16 @@ double forwardGap(std::uint16_t from, std::uint16_t to) {
 
 }  // namespace
 
-Vlp16Decoder::Vlp16Decoder(const std::array<double, kBeams>& elevation_deg)
-    : beams_(BeamTable::fromElevationsDeg(elevation_deg)) {}
+Vlp16Decoder::Vlp16Decoder(const std::array<double, kBeams>& elevation_deg, std::vector<std::uint8_t> accept_products)
+    : beams_(BeamTable::fromElevationsDeg(elevation_deg)), accept_products_(std::move(accept_products)) {}
 
 PacketStatus Vlp16Decoder::decode(const std::uint8_t* data, std::size_t size, DecodedPacket& out) const {
   resetPacket(out, SensorClock::kMicrosPastHour);
   if (data == nullptr || size != kVlp16PacketSize) return PacketStatus::kWrongSize;
   const std::uint8_t mode = data[1204], product = data[1205];
-  if (product != kVlp16ProductId && product != 0) return PacketStatus::kUnknownProduct;
+  if (product != kVlp16ProductId && product != 0 &&
+      std::find(accept_products_.begin(), accept_products_.end(), product) == accept_products_.end())
+    return PacketStatus::kUnknownProduct;
   if (mode != kVlp16Strongest && mode != kVlp16Last && mode != kVlp16Dual && mode != 0)
     return PacketStatus::kUnknownReturnMode;
   std::uint16_t azimuth[kBlocks];

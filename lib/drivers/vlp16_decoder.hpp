@@ -14,6 +14,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <vector>
 
 namespace adit::drivers {
 
@@ -32,13 +33,17 @@ constexpr std::array<double, kBeams> kVlp16ElevationsDeg = {-15, 1, -13, 3, -11,
 class Vlp16Decoder {
  public:
   // elevation_deg: per laser id; a calibrated unit may differ slightly from the nominal table.
-  explicit Vlp16Decoder(const std::array<double, kBeams>& elevation_deg = kVlp16ElevationsDeg);
+  // accept_products: factory product ids decoded besides 0x22 and 0 (units that announce another product
+  // but send VLP-16 packets).
+  explicit Vlp16Decoder(const std::array<double, kBeams>& elevation_deg = kVlp16ElevationsDeg,
+                        std::vector<std::uint8_t> accept_products = {});
 
   // Decodes one UDP payload into `out` (cleared first). Anything but kOk leaves `out` empty.
   PacketStatus decode(const std::uint8_t* data, std::size_t size, DecodedPacket& out) const;
 
  private:
   BeamTable beams_;
+  std::vector<std::uint8_t> accept_products_;
 };
 
 }  // namespace adit::drivers

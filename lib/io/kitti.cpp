@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <stdexcept>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -191,6 +192,39 @@ const KittiCalibration& KittiSequence::calibration() const {
   return calibration_;
 }
 
+namespace {
+
+// Rings when the scan order does not show num_beams rows (see KittiSequence::scan).
+KittiRingMethod assignRingsOtherwise(std::vector<LidarPoint>& points, int num_beams) {
+  if (num_beams == kKittiNumBeams) {
+    assignRingsByElevation(points, hdl64Elevations(), M_PI);
+    return KittiRingMethod::kNominalElevationTable;
+  }
+  const std::vector<double> peaks = elevationPeaks(points);
+  if (static_cast<int>(peaks.size()) == num_beams) {
+    assignRingsByElevation(points, peaks, M_PI);
+    return KittiRingMethod::kElevationPeaks;
+  }
+  double low = M_PI, high = -M_PI;
+  for (const LidarPoint& pt : points) {
+    if (!pt.p.allFinite()) continue;
+    const double e = std::atan2(static_cast<double>(pt.p.z()), std::hypot(static_cast<double>(pt.p.x()), static_cast<double>(pt.p.y())));
+    low = std::min(low, e);
+    high = std::max(high, e);
+  }
+  if (low > high) low = high = 0.0;
+  assignRingsByElevation(points, uniformElevations(num_beams, low, high), M_PI);
+  return KittiRingMethod::kUniformFan;
+}
+
+}  // namespace
+
+void KittiSequence::setNumBeams(int num_beams) {
+  if (num_beams < 1 || num_beams > 255)
+    throw std::invalid_argument("KITTI: " + std::to_string(num_beams) + " beams (1..255)");
+  num_beams_ = num_beams;
+}
+
 LidarScan KittiSequence::scan(std::size_t i, KittiScanReport* report) const {
   if (i >= size())
     throw ReadError("KITTI: scan index " + std::to_string(i) + " out of range (" + std::to_string(size()) + " scans in '" +
@@ -199,8 +233,8 @@ LidarScan KittiSequence::scan(std::size_t i, KittiScanReport* report) const {
   scan.points = readKittiBin(scan_files_[i]);
   scan.utime = utime(i);
   scan.seq = static_cast<std::int64_t>(i);
-  scan.sensor = "hdl64";
-  scan.num_beams = kKittiNumBeams;
+  scan.sensor = num_beams_ == kKittiNumBeams ? "hdl64" : "";
+  scan.num_beams = num_beams_;
   scan.sweep_duration = static_cast<float>(kKittiSweepDuration);
   scan.deskewed = false;
 
@@ -212,10 +246,7 @@ LidarScan KittiSequence::scan(std::size_t i, KittiScanReport* report) const {
     }
     pt.dt = kittiPointDt(pt.p.x(), pt.p.y());
   }
-  if (!assignRingsByScanOrder(scan.points, kKittiNumBeams)) {
-    local.ring_method = KittiRingMethod::kNominalElevationTable;
-    assignRingsByElevation(scan.points, hdl64Elevations(), M_PI);
-  }
+  if (!assignRingsByScanOrder(scan.points, num_beams_)) local.ring_method = assignRingsOtherwise(scan.points, num_beams_);
   scan.has_ring = true;
   scan.has_time = true;
   if (report) *report = local;

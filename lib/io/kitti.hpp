@@ -45,7 +45,7 @@ struct KittiCalibration {
   Eigen::Isometry3d T_cam0_velo = Eigen::Isometry3d::Identity();  // Tr: velodyne -> left camera
 };
 
-enum class KittiRingMethod { kScanOrder, kNominalElevationTable };
+enum class KittiRingMethod { kScanOrder, kNominalElevationTable, kElevationPeaks, kUniformFan };
 
 // What scan() found besides the points (optional out-parameter).
 struct KittiScanReport {
@@ -91,7 +91,16 @@ class KittiSequence {
   bool hasCalibration() const { return has_calibration_; }
   const KittiCalibration& calibration() const;  // throws ReadError naming calib.txt if it was missing
 
-  // Scan i: sensor "hdl64", 64 beams, utime from times.txt, seq = i, rings and dt set (see above).
+  // Beams of the sensor that wrote the folder (KITTI: the HDL-64E's 64, the default). KITTI-layout folders
+  // written from other heads (16, 32, 128 beams) set theirs, e.g. from detectBeamCount() of scan 0.
+  // Throws std::invalid_argument unless 1..255.
+  void setNumBeams(int num_beams);
+  int numBeams() const { return num_beams_; }
+
+  // Scan i: sensor "hdl64" with 64 beams (else "", unknown, with numBeams()), utime from times.txt, seq = i,
+  // rings and dt set (see above). Rings with another beam count: by scan order if the file shows that many
+  // rows, else by the scan's elevation peaks if there are that many, else a uniform fan over the scan's
+  // elevation span.
   // Throws ReadError (bad index, missing or corrupt file).
   LidarScan scan(std::size_t i, KittiScanReport* report = nullptr) const;
 
@@ -108,6 +117,7 @@ class KittiSequence {
   std::vector<double> times_;  // one per scan file, matched by the file's number
   bool has_calibration_ = false;
   KittiCalibration calibration_;
+  int num_beams_ = kKittiNumBeams;
 };
 
 }  // namespace adit::io

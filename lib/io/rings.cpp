@@ -78,10 +78,12 @@ RingAssignmentStats assignRingsByElevation(std::vector<LidarPoint>& points, cons
   return stats;
 }
 
-bool assignRingsByScanOrder(std::vector<LidarPoint>& points, int num_beams, int min_row_points) {
-  if (num_beams <= 0 || points.empty()) return false;
-  // First pass: row index of every point, without touching the points.
-  std::vector<int> row_of(points.size(), 0);
+namespace {
+
+// Row index of every point of a cloud stored beam by beam; returns the number of rows.
+int scanOrderRows(const std::vector<LidarPoint>& points, int min_row_points, std::vector<int>& row_of) {
+  row_of.assign(points.size(), 0);
+  if (points.empty()) return 0;
   int row = 0;
   int points_in_row = 0;
   bool have_previous = false;
@@ -104,7 +106,70 @@ bool assignRingsByScanOrder(std::vector<LidarPoint>& points, int num_beams, int 
     row_of[i] = row;  // an invalid point stays in the row it was stored in
     ++points_in_row;
   }
-  if (row + 1 != num_beams) return false;
+  return row + 1;
+}
+
+}  // namespace
+
+int countScanOrderRows(const std::vector<LidarPoint>& points, int min_row_points) {
+  std::vector<int> row_of;
+  return scanOrderRows(points, min_row_points, row_of);
+}
+
+std::vector<double> elevationPeaks(const std::vector<LidarPoint>& points) {
+  constexpr double kBinDeg = 0.05, kMaxDeg = 45.0;
+  const int bins = static_cast<int>(2 * kMaxDeg / kBinDeg);
+  std::vector<double> count(static_cast<std::size_t>(bins), 0.0), sum(count.size(), 0.0);
+  for (const LidarPoint& pt : points) {
+    if (!pt.p.allFinite()) continue;
+    const double h = std::hypot(static_cast<double>(pt.p.x()), static_cast<double>(pt.p.y()));
+    if (h <= 0.0) continue;
+    const double e = std::atan2(static_cast<double>(pt.p.z()), h) * 180.0 / M_PI;
+    const int b = static_cast<int>(std::floor((e + kMaxDeg) / kBinDeg));
+    if (b < 0 || b >= bins) continue;
+    count[static_cast<std::size_t>(b)] += 1.0;
+    sum[static_cast<std::size_t>(b)] += e;
+  }
+  std::vector<double> smooth(count.size(), 0.0);
+  for (int b = 0; b < bins; ++b)
+    for (int d = -1; d <= 1; ++d)
+      if (b + d >= 0 && b + d < bins) smooth[static_cast<std::size_t>(b)] += count[static_cast<std::size_t>(b + d)] / 3.0;
+  double total = 0.0;
+  int filled = 0;
+  for (double c : smooth)
+    if (c > 0) {
+      total += c;
+      ++filled;
+    }
+  std::vector<double> peaks;
+  if (filled == 0) return peaks;
+  const double threshold = 0.2 * total / filled;
+  double run_count = 0.0, run_sum = 0.0;
+  for (int b = 0; b <= bins; ++b) {
+    if (b < bins && smooth[static_cast<std::size_t>(b)] > threshold) {
+      run_count += count[static_cast<std::size_t>(b)];
+      run_sum += sum[static_cast<std::size_t>(b)];
+    } else if (run_count > 0) {
+      peaks.push_back(run_sum / run_count * M_PI / 180.0);
+      run_count = run_sum = 0.0;
+    }
+  }
+  return peaks;
+}
+
+int detectBeamCount(const std::vector<LidarPoint>& points) {
+  const int rows = countScanOrderRows(points);
+  for (int fan : {16, 32, 40, 64, 128})
+    if (rows == fan) return rows;
+  const int peaks = static_cast<int>(elevationPeaks(points).size());
+  return peaks >= 4 && peaks <= 128 ? peaks : 0;
+}
+
+bool assignRingsByScanOrder(std::vector<LidarPoint>& points, int num_beams, int min_row_points) {
+  if (num_beams <= 0 || points.empty()) return false;
+  std::vector<int> row_of;
+  const int rows = scanOrderRows(points, min_row_points, row_of);
+  if (rows != num_beams) return false;
   for (size_t i = 0; i < points.size(); ++i) points[i].ring = static_cast<std::uint16_t>(num_beams - 1 - row_of[i]);
   return true;
 }

@@ -46,5 +46,17 @@ RingAssignmentStats assignRingsByElevation(std::vector<LidarPoint>& points, cons
 // previous one is jitter, not a new row. If exactly `num_beams` rows are found, sets ring = num_beams-1-row
 // and returns true; otherwise leaves the points unchanged and returns false (caller falls back).
 bool assignRingsByScanOrder(std::vector<LidarPoint>& points, int num_beams, int min_row_points = 10);
+// Rows of a cloud stored beam by beam (as assignRingsByScanOrder counts them); 0 for an empty cloud.
+int countScanOrderRows(const std::vector<LidarPoint>& points, int min_row_points = 10);
+
+// The beams a cloud shows in its elevation histogram (0.05 deg bins over +-45 deg, lightly smoothed): each run
+// of bins holding more than a fifth of the average non-empty bin is one beam, at the run's weighted mean
+// elevation (radians, ascending). Clear for fans whose beams are >= 0.3 deg apart (16- and 32-beam heads);
+// for denser fans (HDL-64E, 128-beam heads) neighbouring beams merge and the scan order is the reliable count.
+std::vector<double> elevationPeaks(const std::vector<LidarPoint>& points);
+
+// Beam count of a sweep written by an unknown sensor: its scan-order rows if they are a usual fan size
+// (16, 32, 40, 64, 128), else the elevation peaks if they are 4..128 of them, else 0 (unknown).
+int detectBeamCount(const std::vector<LidarPoint>& points);
 
 }  // namespace adit::io

@@ -38,9 +38,7 @@ adit::point_cloud_t toMessage(const std::vector<LidarPoint>& points, const Lidar
   m.sensor = like.sensor;
   m.num_beams = static_cast<std::int16_t>(like.num_beams);
   m.sweep_duration = like.sweep_duration;
-  m.flags = (like.has_ring ? adit::point_cloud_t::FLAG_HAS_RING : 0) |
-            (like.has_time ? adit::point_cloud_t::FLAG_HAS_TIME : 0) |
-            (like.deskewed ? adit::point_cloud_t::FLAG_DESKEWED : 0);
+  m.flags = sweepFlags(like);
   const std::size_t n = points.size();
   m.num_points = static_cast<std::int32_t>(n);
   m.x.resize(n);
@@ -113,21 +111,6 @@ ImuSample fromMessage(const adit::imu_t& m) {
   return imu;
 }
 
-namespace {
-
-std::int32_t sweepFlags(const LidarScan& scan) {
-  return (scan.has_ring ? adit::point_cloud_t::FLAG_HAS_RING : 0) |
-         (scan.has_time ? adit::point_cloud_t::FLAG_HAS_TIME : 0) |
-         (scan.deskewed ? adit::point_cloud_t::FLAG_DESKEWED : 0);
-}
-
-void setSweepFlags(std::int32_t flags, LidarScan& scan) {
-  scan.has_ring = (flags & adit::point_cloud_t::FLAG_HAS_RING) != 0;
-  scan.has_time = (flags & adit::point_cloud_t::FLAG_HAS_TIME) != 0;
-  scan.deskewed = (flags & adit::point_cloud_t::FLAG_DESKEWED) != 0;
-}
-
-}  // namespace
 
 adit::features_t toMessage(const FeatureSet& f) {
   adit::features_t m;

@@ -45,9 +45,7 @@ void fillCommon(const LidarScan& scan, adit::lidar_scan_t& m) {
   m.sensor = scan.sensor;
   m.num_beams = static_cast<std::int16_t>(std::clamp(scan.num_beams, 0, 255));
   m.sweep_duration = scan.sweep_duration;
-  m.flags = (scan.has_ring ? adit::point_cloud_t::FLAG_HAS_RING : 0) |
-            (scan.has_time ? adit::point_cloud_t::FLAG_HAS_TIME : 0) |
-            (scan.deskewed ? adit::point_cloud_t::FLAG_DESKEWED : 0);
+  m.flags = sweepFlags(scan);
   m.azimuth_rate = 0.0f;
   m.num_columns = 0;
   m.num_returns = 0;

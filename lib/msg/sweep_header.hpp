@@ -8,6 +8,20 @@
 
 namespace adit::msg {
 
+// point_cloud_t's flag bits of a sweep.
+inline std::int32_t sweepFlags(const LidarScan& scan) {
+  return (scan.has_ring ? adit::point_cloud_t::FLAG_HAS_RING : 0) |
+         (scan.has_time ? adit::point_cloud_t::FLAG_HAS_TIME : 0) |
+         (scan.deskewed ? adit::point_cloud_t::FLAG_DESKEWED : 0) |
+         (scan.partial ? adit::point_cloud_t::FLAG_PARTIAL : 0);
+}
+inline void setSweepFlags(std::int32_t flags, LidarScan& scan) {
+  scan.has_ring = (flags & adit::point_cloud_t::FLAG_HAS_RING) != 0;
+  scan.has_time = (flags & adit::point_cloud_t::FLAG_HAS_TIME) != 0;
+  scan.deskewed = (flags & adit::point_cloud_t::FLAG_DESKEWED) != 0;
+  scan.partial = (flags & adit::point_cloud_t::FLAG_PARTIAL) != 0;
+}
+
 template <class SweepMessage>
 LidarScan sweepHeader(const SweepMessage& m) {
   LidarScan s;
@@ -16,9 +30,7 @@ LidarScan sweepHeader(const SweepMessage& m) {
   s.sensor = m.sensor;
   s.num_beams = m.num_beams;
   s.sweep_duration = m.sweep_duration;
-  s.has_ring = (m.flags & adit::point_cloud_t::FLAG_HAS_RING) != 0;
-  s.has_time = (m.flags & adit::point_cloud_t::FLAG_HAS_TIME) != 0;
-  s.deskewed = (m.flags & adit::point_cloud_t::FLAG_DESKEWED) != 0;
+  setSweepFlags(m.flags, s);
   return s;
 }
 

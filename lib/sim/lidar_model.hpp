@@ -88,6 +88,7 @@ class LidarSimulator {
                      std::int64_t seq, std::uint64_t seed) const;
 
   const LidarProfile& profile() const { return profile_; }
+  const LidarNoiseConfig& noise() const { return noise_; }
   // Firing time of (column, channel) relative to the sweep's last firing (s, <= 0).
   double firingOffset(int column, int channel) const;
 

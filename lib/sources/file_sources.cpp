@@ -2,6 +2,7 @@
 
 #include "io/imu_csv.hpp"
 #include "io/kitti.hpp"
+#include "io/rings.hpp"
 #include "msg/convert.hpp"
 #include "msg/encode.hpp"
 #include "msg/sweep_codec.hpp"
@@ -101,8 +102,16 @@ class ImuSource : public runtime::MessageSource {
 
 }  // namespace
 
-std::unique_ptr<runtime::MessageSource> makeKittiSource(const std::string& sequence_dir, const std::string& channel) {
+std::unique_ptr<runtime::MessageSource> makeKittiSource(const std::string& sequence_dir, const std::string& channel,
+                                                        int num_beams) {
   auto sequence = std::make_shared<io::KittiSequence>(sequence_dir);
+  if (num_beams == 0 && sequence->size() > 0) {
+    num_beams = io::detectBeamCount(io::readKittiBin(sequence->scanFiles().front()));
+    if (num_beams == 0) throw io::ReadError("KITTI: cannot tell the beam count of '" + sequence->scanFiles().front() +
+                                            "' (neither its scan order nor its elevations show it): give --beams N");
+    spdlog::info("KITTI: {} beams (detected from the first scan)", num_beams);
+  }
+  if (num_beams > 0) sequence->setNumBeams(num_beams);
   return std::make_unique<ScanFileSource>(sequence->size(), [sequence](std::size_t i) { return sequence->scan(i); },
                                           channel);
 }

@@ -11,8 +11,10 @@
 
 namespace adit::sources {
 
-// KITTI odometry layout: <dir> is sequences/NN (velodyne/*.bin, times.txt, calib.txt).
-std::unique_ptr<runtime::MessageSource> makeKittiSource(const std::string& sequence_dir, const std::string& channel);
+// KITTI odometry layout: <dir> is sequences/NN (velodyne/*.bin, times.txt, calib.txt). num_beams: of the sensor
+// that wrote it; 0 = detected from the first scan (io::detectBeamCount: 64 on KITTI itself).
+std::unique_ptr<runtime::MessageSource> makeKittiSource(const std::string& sequence_dir, const std::string& channel,
+                                                        int num_beams = 0);
 
 // A folder of PCD files, one sweep each, sorted by name.
 std::unique_ptr<runtime::MessageSource> makePcdSource(const std::string& folder, const io::PcdFolderConfig& config,

@@ -51,6 +51,7 @@ bool SimSource::next(runtime::OutgoingMessage& out) {
     if (!scan) ++imu_seq_;
   }
   if (event.kind == sim::SimEvent::Kind::Scan) {
+    if (observer_) observer_(event.scan);
     out = {channels_.lidar,
            channels_.compact_sweeps ? msg::encode(msg::encodeSweep(event.scan, &firing_table_))
                                     : msg::encode(msg::toMessage(event.scan)),

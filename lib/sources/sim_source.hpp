@@ -7,6 +7,7 @@
 #include "runtime/source.hpp"
 #include "sim/simulator.hpp"
 
+#include <functional>
 #include <memory>
 
 namespace adit::sources {
@@ -41,6 +42,8 @@ class SimSource : public runtime::MessageSource {
   double progress() const override;
 
   const sim::Simulator& simulator() const { return simulator_; }
+  // Called with every sweep as it is published (e.g. to also write it as sensor packets, `--pcap`).
+  void setSweepObserver(std::function<void(const LidarScan&)> observer) { observer_ = std::move(observer); }
   // T_world_lidar at each sweep's utime (its last firing), in the order published (stalled sweeps left out).
   const Trajectory& groundTruth() const { return truth_; }
 
@@ -55,6 +58,7 @@ class SimSource : public runtime::MessageSource {
   Trajectory truth_;
   std::optional<runtime::OutgoingMessage> pending_truth_;  // published right after its sweep
   std::int64_t imu_seq_ = 0, truth_seq_ = 0;
+  std::function<void(const LidarScan&)> observer_;
 };
 
 }  // namespace adit::sources

@@ -3,25 +3,29 @@
 #include "drivers/udp_lidar_source.hpp"
 #include "runtime/process.hpp"
 #include "sources/file_sources.hpp"
+#include "sources/pcap_source.hpp"
 
 namespace adit::sources {
 
 void addLidarSourceOptions(CLI::App& app, LidarSourceArgs& a, bool kind_positional) {
   if (kind_positional) {
-    app.add_option("kind", a.kind, "Data set kind: kitti | pcd")->required()->check(CLI::IsMember({"kitti", "pcd"}));
-    app.add_option("path", a.path, "KITTI sequence folder (sequences/NN) or folder of PCD files")
-        ->required()->check(CLI::ExistingDirectory);
+    app.add_option("kind", a.kind, "Data set kind: kitti | pcd | pcap")->required()->check(CLI::IsMember({"kitti", "pcd", "pcap"}));
+    app.add_option("path", a.path, "KITTI sequence folder (sequences/NN), folder of PCD files or a .pcap/.pcapng capture")
+        ->required()->check(CLI::ExistingPath);
   } else {
-    app.add_option("--source", a.kind, "kitti | pcd (recorded files) or vlp16 | rs16 (live sensor packets over UDP)")
-        ->required()->check(CLI::IsMember({"kitti", "pcd", "vlp16", "rs16"}));
-    app.add_option("--path", a.path, "kitti/pcd: KITTI sequence folder (sequences/NN) or folder of PCD files")
-        ->check(CLI::ExistingDirectory);
-    app.add_option("--driver-config", a.driver_configs, "vlp16/rs16: YAML with lidar_driver.* keys (launch/sensors/)");
-    app.add_option("--port", a.port, "vlp16/rs16: UDP data port (default 2368 / 6699)");
+    app.add_option("--source", a.kind,
+                   "kitti | pcd | pcap (recorded files) or vlp16 | rs16 (live sensor packets over UDP)")
+        ->required()->check(CLI::IsMember({"kitti", "pcd", "pcap", "vlp16", "rs16"}));
+    app.add_option("--path", a.path, "kitti/pcd/pcap: KITTI sequence folder (sequences/NN), folder of PCD files or a "
+                   "capture file")->check(CLI::ExistingPath);
   }
+  app.add_option("--driver-config", a.driver_configs, "pcap, vlp16/rs16: YAML with lidar_driver.* keys (launch/sensors/)");
+  app.add_option("--port", a.port, "pcap, vlp16/rs16: UDP data port (default 2368 / 6699)");
   app.add_option("--channel", a.channel, "Channel of the sweeps");
-  app.add_option("--sensor", a.sensor, "PCD: sensor profile for rings by elevation (vlp16, rs16, hdl64)");
-  app.add_option("--beams", a.beams, "PCD: beam count for a uniform fan when the profile is unknown");
+  app.add_option("--sensor", a.sensor, "pcap: the sensor that sent the packets (vlp16, rs16); PCD: sensor profile for "
+                 "rings by elevation (vlp16, rs16, hdl64)");
+  app.add_option("--beams", a.beams, "KITTI: beams of the sensor that wrote the folder (default: detected from the "
+                 "first scan); PCD: beam count for a uniform fan when the profile is unknown")->check(CLI::Range(0, 255));
   app.add_option("--period", a.period_s, "PCD: sweep period (s) when file names are not timestamps");
 }
 
@@ -36,7 +40,14 @@ std::unique_ptr<runtime::MessageSource> makeLidarSource(const LidarSourceArgs& a
     return drivers::makeUdpLidarSource(config);
   }
   if (a.path.empty()) throw std::runtime_error("--path is required for a " + a.kind + " source");
-  if (a.kind == "kitti") return makeKittiSource(a.path, a.channel);
+  if (a.kind == "pcap") {
+    drivers::UdpLidarConfig config = drivers::udpLidarConfigFrom(runtime::loadConfig(a.driver_configs));
+    config.model = a.sensor;
+    config.channel = a.channel;
+    if (a.port > 0) config.port = a.port;
+    return makePcapLidarSource(a.path, config);
+  }
+  if (a.kind == "kitti") return makeKittiSource(a.path, a.channel, a.beams);
   if (a.kind == "pcd") {
     io::PcdFolderConfig config;
     config.sensor = a.sensor;
@@ -44,7 +55,7 @@ std::unique_ptr<runtime::MessageSource> makeLidarSource(const LidarSourceArgs& a
     config.sweep_duration = a.period_s;
     return makePcdSource(a.path, config, a.channel);
   }
-  throw std::runtime_error("unknown source kind '" + a.kind + "' (kitti or pcd)");
+  throw std::runtime_error("unknown source kind '" + a.kind + "' (kitti, pcd or pcap)");
 }
 
 }  // namespace adit::sources

@@ -11,14 +11,14 @@
 namespace adit::sources {
 
 struct LidarSourceArgs {
-  std::string kind;   // "kitti", "pcd" (recorded) or "vlp16", "rs16" (live UDP packets)
-  std::string path;   // sequence folder or PCD folder
-  std::vector<std::string> driver_configs;  // live: YAML with lidar_driver.* keys
-  int port = 0;                              // live: UDP port (0 = the sensor's default)
+  std::string kind;   // "kitti", "pcd", "pcap" (recorded) or "vlp16", "rs16" (live UDP packets)
+  std::string path;   // sequence folder, PCD folder or capture file
+  std::vector<std::string> driver_configs;  // live and pcap: YAML with lidar_driver.* keys
+  int port = 0;                              // live and pcap: UDP port (0 = the sensor's default)
   std::string channel = "LIDAR_POINTS";
-  // PCD only: sensor profile for rings by elevation when the files have no ring field.
+  // pcap: the sensor model; PCD: sensor profile for rings by elevation when the files have no ring field.
   std::string sensor = "vlp16";
-  int beams = 0;              // 0 = the profile's
+  int beams = 0;              // KITTI: the sensor's (0 = detected); PCD: 0 = the profile's
   double period_s = 0.1;      // sweep period when file names are not timestamps
 };
 

@@ -1,4 +1,4 @@
-// adit import kitti <sequence_dir> -o <log>   |   adit import pcd <dir> -o <log>
+// adit import kitti <sequence_dir> -o <log>  |  adit import pcd <dir> -o <log>  |  adit import pcap <file> --sensor S -o <log>
 #include "commands.hpp"
 
 #include "runtime/source.hpp"
@@ -7,7 +7,7 @@
 void registerImportCommand(CLI::App& app) {
   auto source = std::make_shared<adit::sources::LidarSourceArgs>();
   auto output = std::make_shared<std::string>();
-  auto* cmd = app.add_subcommand("import", "Convert a data set (KITTI odometry layout, PCD folder) into an LCM log");
+  auto* cmd = app.add_subcommand("import", "Convert a data set (KITTI odometry layout, PCD folder, pcap/pcapng capture of a VLP-16 / RS-16) into an LCM log");
   addLidarSourceOptions(*cmd, *source, true);
   cmd->add_option("-o,--output", *output, "LCM log to write")->required();
   auto keep_going = std::make_shared<bool>(false);
@@ -17,7 +17,8 @@ void registerImportCommand(CLI::App& app) {
     adit::runtime::SourceRunOptions run;
     run.process = "import";
     run.output_log = *output;
-    run.keep_going = *keep_going;
+    // A capture always holds some foreign or damaged packets: they are counted and listed, never fatal.
+    run.keep_going = *keep_going || source->kind == "pcap";
     run.input = source->path;
     auto src = adit::sources::makeLidarSource(*source);
     if (const int code = adit::runtime::runSource(*src, run); code != 0) throw CLI::RuntimeError(code);

@@ -4,6 +4,8 @@
 #include "eval/trajectory_io.hpp"
 #include "io/pcd.hpp"
 #include "runtime/process.hpp"
+#include "io/atomic_file.hpp"
+#include "sources/sim_pcap.hpp"
 #include "sources/sim_source.hpp"
 
 #include <fmt/format.h>
@@ -13,7 +15,7 @@ namespace {
 
 struct SimArgs {
   std::vector<std::string> configs;
-  std::string world, sensor, output, gt, world_pcd, lcm_url;
+  std::string world, sensor, output, gt, world_pcd, lcm_url, pcap;
   double duration_s = -1, rate = 1.0, world_spacing = 0.1, start_speed = -1;
   std::int64_t seed = -1;
   bool live = false, no_truth_channel = false, no_imu = false;
@@ -54,6 +56,8 @@ void registerSimCommand(CLI::App& app) {
   cmd->add_option("-o,--output", a->output, "LCM log to write (LIDAR_POINTS, IMU, GROUND_TRUTH)");
   cmd->add_option("--gt", a->gt, "Ground truth as TUM: T_world_lidar at each sweep's utime (its last firing)");
   cmd->add_option("--world-pcd", a->world_pcd, "Also write the world's surfaces as a PCD (for comparing with the map)");
+  cmd->add_option("--pcap", a->pcap, "Also write the lidar as the VLP-16 packet capture a real sensor would give "
+                 "(classic pcap; --sensor vlp16 only)");
   cmd->add_option("--world-spacing", a->world_spacing, "Point spacing of --world-pcd (m)")->check(CLI::PositiveNumber);
   cmd->add_flag("--live", a->live, "Publish over LCM in real time instead of writing a log");
   cmd->add_option("--rate", a->rate, "With --live: multiple of real time (0 = as fast as possible)")->check(CLI::NonNegativeNumber);
@@ -97,7 +101,19 @@ void registerSimCommand(CLI::App& app) {
     run.output_log = a->output;
     run.lcm_url = a->lcm_url;
     run.rate = a->rate;
-    if (const int code = adit::runtime::runSource(source, run); code != 0) throw CLI::RuntimeError(code);
+    if (a->pcap.empty()) {
+      if (const int code = adit::runtime::runSource(source, run); code != 0) throw CLI::RuntimeError(code);
+    } else {
+      // The capture is written alongside, atomically: a failed run leaves no file.
+      std::int64_t packets = 0;
+      adit::io::writeFileAtomically(a->pcap, [&](std::ostream& out) {
+        adit::sources::SimPcapRecorder recorder(source.simulator().lidar(), out);
+        source.setSweepObserver([&recorder](const adit::LidarScan& scan) { recorder.addSweep(scan); });
+        if (const int code = adit::runtime::runSource(source, run); code != 0) throw CLI::RuntimeError(code);
+        packets = recorder.packets();
+      });
+      fmt::print("sim: wrote {} VLP-16 packets to {}\n", packets, a->pcap);
+    }
     if (!a->gt.empty()) {
       adit::eval::writeTum(a->gt, source.groundTruth());
       fmt::print("sim: wrote ground truth ({} poses) to {}\n", source.groundTruth().size(), a->gt);

@@ -1,5 +1,6 @@
 // adit-lidar-bridge: publishes sweeps on LIDAR_POINTS: live from a VLP-16 / RS-16 (UDP packets), or
-// recorded (KITTI layout, PCD folder) at the recorded rate (or --rate times it); -o writes an LCM log instead.
+// recorded (KITTI layout, PCD folder, pcap/pcapng capture of the sensor's packets) at the recorded rate (or
+// --rate times it; 0 = as fast as possible); -o writes an LCM log instead.
 #include "runtime/process.hpp"
 #include "runtime/source.hpp"
 #include "sources/source_options.hpp"

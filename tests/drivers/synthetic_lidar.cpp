@@ -27,10 +27,12 @@ int ringOf(Model model, int laser) {
   return laser < 8 ? laser : 23 - laser;
 }
 
-std::int64_t SyntheticLidar::blockNs() const { return model == Model::kVlp16 ? 110592 : 111000; }
-int SyntheticLidar::groupsPerPacket() const { return dual ? 6 : 12; }
+// RS-16 dual return: one sequence per block (both echoes in it), so a block is one sequence long.
+std::int64_t SyntheticLidar::blockNs() const { return model == Model::kVlp16 ? 110592 : dual ? 55500 : 111000; }
+int SyntheticLidar::groupsPerPacket() const { return dual && model == Model::kVlp16 ? 6 : 12; }
 std::int64_t SyntheticLidar::lastFiringNs() const {
-  return model == Model::kVlp16 ? packetNs() - blockNs() + 55296 + 15 * 2304 : packetNs() - blockNs() + 55500 + 15 * 2800;
+  if (model == Model::kVlp16) return packetNs() - blockNs() + 55296 + 15 * 2304;
+  return packetNs() - blockNs() + (dual ? 0 : 55500) + 15 * 2800;
 }
 
 std::int64_t SyntheticLidar::stampUs(int k) const {
@@ -45,16 +47,20 @@ std::vector<std::uint8_t> SyntheticLidar::packet(int k, std::vector<TruthFiring>
   const double unit = vlp ? 0.002 : 0.005;
   const std::int64_t sequence_ns = vlp ? 55296 : 55500, firing_ns = vlp ? 2304 : 2800;
   const int returns = dual ? 2 : 1;
+  // VLP-16 dual: block pairs (one per echo) of two sequences; RS-16 dual: one block of one sequence whose
+  // slots 0..15 hold the first echo and 16..31 the second.
+  const bool rs_dual = !vlp && dual;
+  const int blocks_per_group = rs_dual ? 1 : returns, sequences = rs_dual ? 1 : 2;
   for (int g = 0; g < groupsPerPacket(); ++g) {
     const std::int64_t n = static_cast<std::int64_t>(k) * groupsPerPacket() + g;  // global block (group) index
     const int az_raw = static_cast<int>((az0_centideg + gap_centideg * n) % 36000);
-    for (int r = 0; r < returns; ++r) {
-      std::uint8_t* block = bytes.data() + header + static_cast<std::size_t>((g * returns + r) * 100);
+    for (int r = 0; r < blocks_per_group; ++r) {
+      std::uint8_t* block = bytes.data() + header + static_cast<std::size_t>((g * blocks_per_group + r) * 100);
       block[0] = 0xFF;
       block[1] = 0xEE;
       vlp ? putLe16(block + 2, az_raw) : putBe16(block + 2, az_raw);
     }
-    for (int s = 0; s < 2; ++s) {
+    for (int s = 0; s < sequences; ++s) {
       for (int laser = 0; laser < 16; ++laser) {
         const std::int64_t in_block = s * sequence_ns + laser * firing_ns;
         unsigned first_raw = 0;
@@ -66,8 +72,8 @@ std::vector<std::uint8_t> SyntheticLidar::packet(int k, std::vector<TruthFiring>
           if (static_cast<double>(mix(h) >> 11) / 9007199254740992.0 < no_return_fraction) raw = 0;
           if (r == 0) first_raw = raw;
           const int intensity = static_cast<int>((h >> 3) & 0xFF);
-          std::uint8_t* point = bytes.data() + header + static_cast<std::size_t>((g * returns + r) * 100 + 4 +
-                                                                                  (s * 16 + laser) * 3);
+          const int block = rs_dual ? g : g * returns + r, slot = rs_dual ? r * 16 + laser : s * 16 + laser;
+          std::uint8_t* point = bytes.data() + header + static_cast<std::size_t>(block * 100 + 4 + slot * 3);
           vlp ? putLe16(point, raw) : putBe16(point, raw);
           point[2] = static_cast<std::uint8_t>(intensity);
           if (truth == nullptr) continue;

@@ -29,7 +29,7 @@ struct SyntheticLidar {
   int az0_centideg = 1234;    // azimuth of block 0 of packet 0
   int gap_centideg = 40;      // azimuth advance per firing block (0.40 deg: ~10 Hz)
   std::int64_t stamp0_us = 0; // sensor stamp of packet 0 (VLP-16: us past the hour; RS-16: UTC us)
-  bool dual = false;          // VLP-16 dual-return packets
+  bool dual = false;          // dual-return packets (VLP-16: block pairs; RS-16: both echoes in one block)
   double no_return_fraction = 0.05;
   std::uint64_t seed = 1;
 

@@ -73,5 +73,58 @@ def text_seeds():
     for path in sorted(glob.glob("launch/*.launch.yaml") + ["tests/integration/udp.launch.yaml"]):
         put("launch_file", os.path.basename(path), open(path, "rb").read())
 
+def lidar_payload(rs16, k):
+    """A VLP-16 (little-endian) or RS-16 (big-endian, 42-byte header) data packet, azimuth advancing with k."""
+    order = ">" if rs16 else "<"
+    body = b""
+    for b in range(12):
+        body += b"\xff\xee" + struct.pack(order + "H", (1000 + 40 * (12 * k + b)) % 36000)
+        body += b"".join(struct.pack(order + "HB", 500 + 37 * i, i) for i in range(32))
+    if rs16:
+        head = bytes([0x55, 0xAA, 0x05, 0x0A, 0x5A, 0xA5, 0x50, 0xA0]) + bytes(12)
+        head += bytes([24, 3, 15, 10, 20, 30]) + struct.pack(">HH", k, 0) + bytes(12)
+        return head + body + b"\x00\xff" + bytes(4)
+    return body + struct.pack("<I", 1000000 + 1327 * k) + b"\x37\x22"
+
+def ipv4_udp(payload, port, ident, mtu=1500):
+    udp = struct.pack(">HHHH", port, port, 8 + len(payload), 0) + payload
+    step = (mtu - 20) // 8 * 8
+    out = []
+    for at in range(0, len(udp), step):
+        chunk = udp[at:at + step]
+        more = 0x2000 if at + step < len(udp) else 0
+        out.append(struct.pack(">BBHHHBBH4s4s", 0x45, 0, 20 + len(chunk), ident, more | at // 8, 64, 17, 0,
+                               bytes([192, 168, 1, 201]), bytes([192, 168, 1, 100])) + chunk)
+    return out
+
+def pcap_seeds():
+    eth = lambda ip: bytes(6) + bytes([0x60, 0x76, 0x88, 0, 0, 2]) + b"\x08\x00" + ip
+    # classic, microseconds, little-endian, Ethernet: three VLP-16 packets (model byte 0)
+    f = struct.pack("<IHHiIII", 0xA1B2C3D4, 2, 4, 0, 0, 65535, 1)
+    for k in range(3):
+        frame = eth(ipv4_udp(lidar_payload(False, k), 2368, k)[0])
+        f += struct.pack("<IIII", 1700000000, 1327 * k, len(frame), len(frame)) + frame
+    put("pcap", "vlp16_classic_us.pcap", b"\x00" + f)
+    # classic, nanoseconds, big-endian, raw IPv4: an RS-16 packet in 576-byte fragments, one out of order
+    f = struct.pack(">IHHiIII", 0xA1B23C4D, 2, 4, 0, 0, 65535, 101)
+    frags = ipv4_udp(lidar_payload(True, 0), 6699, 7, 576)
+    frags[0], frags[1] = frags[1], frags[0]
+    for i, ip in enumerate(frags):
+        f += struct.pack(">IIII", 1700000000, 1000 * i, len(ip), len(ip)) + ip
+    put("pcap", "rs16_fragments_ns_be.pcap", b"\x01" + f)
+    # pcapng, big-endian: Linux cooked v2 interface in nanoseconds, an EPB and an SPB of RS-16 packets
+    def block(t, body):
+        body += bytes(-len(body) % 4)
+        return struct.pack(">II", t, len(body) + 12) + body + struct.pack(">I", len(body) + 12)
+    ng = block(0x0A0D0D0A, struct.pack(">IHHq", 0x1A2B3C4D, 1, 0, -1))
+    ng += block(1, struct.pack(">HHI", 276, 0, 65535) + struct.pack(">HHB3x", 9, 1, 9) + bytes(4))
+    sll2 = lambda ip: b"\x08\x00" + bytes(6) + b"\x00\x01\x00\x06" + bytes([0x60, 0x76, 0x88, 0, 0, 2, 0, 0]) + ip
+    for k in range(2):
+        frame = sll2(ipv4_udp(lidar_payload(True, k), 6699, k)[0])
+        ng += block(6, struct.pack(">IIIII", 0, 395812, 1000 * k, len(frame), len(frame)) + frame)
+    frame = sll2(ipv4_udp(lidar_payload(True, 2), 6699, 2)[0])
+    ng += block(3, struct.pack(">I", len(frame)) + frame)
+    put("pcap", "rs16_sll2_be.pcapng", b"\x01" + ng)
+
 if __name__ == "__main__":
-    pcd_seeds(); kitti_seeds(); lcmlog_seeds(); text_seeds()
+    pcd_seeds(); kitti_seeds(); lcmlog_seeds(); text_seeds(); pcap_seeds()
