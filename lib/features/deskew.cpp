@@ -87,6 +87,7 @@ std::int32_t deskewPoints(std::vector<LidarPoint>& points, std::int64_t utime, f
   const bool use_motion = priorUsable(motion, cfg);
   const std::vector<Eigen::Quaterniond> imu_q = imuRotations(imu, utime, times, cfg.R_lidar_imu, cfg.max_imu_gap_s);
   if (imu_q.empty() && !use_motion) return 0;
+  if (!use_motion && !cfg.rotation_only_without_prior) return 0;
 
   std::vector<Eigen::Matrix3f> R(steps + 1);
   std::vector<Eigen::Vector3f> t(steps + 1, Eigen::Vector3f::Zero());

@@ -36,7 +36,8 @@ ConfigTable<D> deskewTable() {
    .add("imu_rotation_rpy_deg", &D::imu_rotation_rpy_deg, between(-360, 360), "deg", "rotation R_lidar_imu as [roll, pitch, yaw]")
    .add("table_steps", &D::table_steps, between(1, 10000), "", "poses precomputed across the sweep; points interpolate between them")
    .add("max_imu_gap_s", &D::max_imu_gap_s, atLeast(0), "s", "IMU samples must cover the sweep to within this at both ends, else the motion model is used")
-   .add("max_prior_dt_s", &D::max_prior_dt_s, above(0), "s", "a motion prior spanning more than this (dropped sweeps) is ignored");
+   .add("max_prior_dt_s", &D::max_prior_dt_s, above(0), "s", "a motion prior spanning more than this (dropped sweeps) is ignored")
+   .add("rotation_only_without_prior", &D::rotation_only_without_prior, anyValue(), "", "without a motion prior deskew the IMU rotation alone (false: leave the sweep raw for compensation downstream)");
   return t;
 }
 

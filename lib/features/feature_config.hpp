@@ -69,6 +69,11 @@ struct DeskewConfig {
   double max_imu_gap_s = 0.02;
   // features.deskew.max_prior_dt_s (s): a motion prior spanning more than this (dropped sweeps) is ignored.
   double max_prior_dt_s = 0.5;
+  // features.deskew.rotation_only_without_prior: with no motion prior (the first two sweeps, after a gap)
+  // deskew the IMU's rotation alone. false (default) leaves such a sweep raw: a rotation-only deskew assumes
+  // no translation, wrong when the vehicle already moves (a 1.5 m/s start erred by 6.5 cm on the first
+  // deskewed pair), while a raw sweep is compensated downstream (odometry, mapper) with the motion estimated.
+  bool rotation_only_without_prior = false;
 };
 
 struct LoamConfig {

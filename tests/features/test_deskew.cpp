@@ -116,10 +116,20 @@ TEST_F(Deskew, AnImperfectPriorStillHelps) {
 }
 
 TEST_F(Deskew, ImuRotationAloneRemovesTheRotationalPart) {
-  const Errors e = run(gyro(scan_.utime, Eigen::Quaterniond::Identity()), MotionPrior{}, FeatureSet::kDeskewImu);
+  FeatureConfig cfg;
+  cfg.deskew.rotation_only_without_prior = true;
+  const Errors e = run(gyro(scan_.utime, Eigen::Quaterniond::Identity()), MotionPrior{}, FeatureSet::kDeskewImu, cfg);
   std::printf("IMU rotation only: mean %.2f mm p95 %.2f mm\n", e.mean * 1e3, e.p95 * 1e3);
   EXPECT_LT(e.mean, 0.1 * raw_.mean);
   EXPECT_LT(e.p95, 0.005);
+}
+
+// By default a sweep without a motion prior stays raw even with IMU: deskewing its rotation alone would mark
+// it deskewed while its translation is left (the vehicle may already move), and downstream would then not
+// compensate it.
+TEST_F(Deskew, WithoutAPriorTheSweepStaysRawForCompensationDownstream) {
+  const Errors e = run(gyro(scan_.utime, Eigen::Quaterniond::Identity()), MotionPrior{}, 0);
+  EXPECT_DOUBLE_EQ(e.mean, raw_.mean);
 }
 
 TEST_F(Deskew, ImuRotationWithVelocityAndAnExtrinsicRotation) {
