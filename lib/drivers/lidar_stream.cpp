@@ -2,6 +2,7 @@
 
 #include "drivers/rs16_decoder.hpp"
 #include "drivers/vlp16_decoder.hpp"
+#include "drivers/vlp32_decoder.hpp"
 
 #include <spdlog/spdlog.h>
 
@@ -13,6 +14,11 @@ namespace adit::drivers {
 namespace {
 
 std::array<double, kBeams> elevationTable(const LidarStreamConfig& c) {
+  if (beamsOf(c.model) != kBeams) {
+    if (!c.elevations_deg.empty())
+      throw std::invalid_argument("lidar driver: a vertical angle table is read for 16-beam heads only");
+    return kVlp16ElevationsDeg;  // unused: 32-beam heads carry their own tables
+  }
   if (c.elevations_deg.empty()) return c.model == LidarModel::kVlp16 ? kVlp16ElevationsDeg : kRs16ElevationsDeg;
   if (c.elevations_deg.size() != kBeams)
     throw std::invalid_argument("lidar driver: the elevation table needs 16 angles, got " +
@@ -42,14 +48,25 @@ LidarPacketStream::LidarPacketStream(const LidarStreamConfig& config)
   makeDecoder(elevationTable(config), config.dual_return);
 }
 
+int beamsOf(LidarModel model) {
+  return model == LidarModel::kVlp32c || model == LidarModel::kHdl32e ? kBeams32 : kBeams;
+}
+
 void LidarPacketStream::makeDecoder(const std::array<double, kBeams>& elevations, bool dual_return) {
   elevations_ = elevations;
   dual_return_ = dual_return;
+  std::vector<std::uint8_t> products;
+  for (int id : config_.accept_product_ids) products.push_back(static_cast<std::uint8_t>(id));
+  if (beamsOf(config_.model) == kBeams32) {
+    const Velodyne32 head = config_.model == LidarModel::kVlp32c ? Velodyne32::kVlp32c : Velodyne32::kHdl32e;
+    firing_table_ = firingTable32(head);
+    auto decoder = std::make_shared<Vlp32Decoder>(head, products);
+    decode_ = [decoder](const std::uint8_t* d, std::size_t n, DecodedPacket& out) { return decoder->decode(d, n, out); };
+    return;
+  }
   firing_table_ = drivers::firingTable(BeamTable::fromElevationsDeg(elevations),
                                        config_.model == LidarModel::kVlp16 ? kVlp16FiringNs : kRs16FiringNs);
   if (config_.model == LidarModel::kVlp16) {
-    std::vector<std::uint8_t> products;
-    for (int id : config_.accept_product_ids) products.push_back(static_cast<std::uint8_t>(id));
     auto decoder = std::make_shared<Vlp16Decoder>(elevations, products);
     decode_ = [decoder](const std::uint8_t* d, std::size_t n, DecodedPacket& out) { return decoder->decode(d, n, out); };
   } else {

@@ -18,7 +18,9 @@
 
 namespace adit::drivers {
 
-enum class LidarModel { kVlp16, kRs16 };
+enum class LidarModel { kVlp16, kRs16, kVlp32c, kHdl32e };
+// Beams of a model's head (16 or 32).
+int beamsOf(LidarModel model);
 
 struct LidarStreamConfig {
   LidarModel model = LidarModel::kVlp16;

@@ -18,7 +18,7 @@
 namespace adit::drivers {
 
 struct UdpLidarConfig {
-  // lidar_driver.model: "vlp16" or "rs16".
+  // lidar_driver.model: "vlp16", "rs16", "vlp32c" or "hdl32e" (the 32-beam heads: nominal tables only).
   std::string model = "vlp16";
   // lidar_driver.bind_address: IPv4 address to listen on; 0.0.0.0 = all interfaces (the sensors' factory
   // setting broadcasts / sends to the host, either reaches it).
