@@ -48,6 +48,30 @@ LidarPacketStream::LidarPacketStream(const LidarStreamConfig& config)
   makeDecoder(elevationTable(config), config.dual_return);
 }
 
+bool packetStampKey(LidarModel model, const std::uint8_t* data, std::size_t size, std::int64_t& key) {
+  if (data == nullptr) return false;
+  if (model == LidarModel::kRs16) {
+    if (size != kRs16PacketSize) return false;
+    const std::uint8_t* t = data + 20;  // year-2000, month, day, hour, minute, second, ms u16, us u16
+    key = ((((((static_cast<std::int64_t>(t[0]) * 12 + t[1]) * 31 + t[2]) * 24 + t[3]) * 60 + t[4]) * 60 + t[5]) *
+           1000000) + ((t[6] << 8) | t[7]) * 1000 + ((t[8] << 8) | t[9]);
+    return true;
+  }
+  if (size != kVlp16PacketSize) return false;
+  key = static_cast<std::int64_t>(data[1200]) | (static_cast<std::int64_t>(data[1201]) << 8) |
+        (static_cast<std::int64_t>(data[1202]) << 16) | (static_cast<std::int64_t>(data[1203]) << 24);
+  return true;
+}
+
+std::int64_t unwrapStampKey(LidarModel model, std::int64_t key, std::int64_t reference) {
+  if (model == LidarModel::kRs16) return key;
+  constexpr std::int64_t kHour = 3600000000LL;
+  std::int64_t d = (key - reference) % kHour;
+  if (d > kHour / 2) d -= kHour;
+  if (d < -kHour / 2) d += kHour;
+  return reference + d;
+}
+
 int beamsOf(LidarModel model) {
   return model == LidarModel::kVlp32c || model == LidarModel::kHdl32e ? kBeams32 : kBeams;
 }

@@ -55,7 +55,7 @@ struct UdpLidarConfig {
   // lidar_driver.difop_port: RS-16 only: the port of the DIFOP packets (recordings; 0 = 7788).
   int difop_port = 0;
   // lidar_driver.sensor_address: recordings (pcap): only datagrams from this IPv4 address are the sensor's;
-  // "" = the first host that sends a valid packet to the data port.
+  // "" = the first host that sends a packet of the model's size to the data port.
   std::string sensor_address;
   // lidar_driver.idle_timeout_s: next() reports the end after this long without a packet (s); 0 = wait
   // for the sensor forever (stops only on SIGINT/SIGTERM).
