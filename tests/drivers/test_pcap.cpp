@@ -34,7 +34,8 @@ constexpr std::uint32_t kSensorIp = 0xC0A801C9, kHostIp = 0xC0A80164, kOtherIp =
 struct Recording {
   int packets = 0;
   int lost = -1;        // never written
-  int reordered = -1;   // written after packet reordered + 1 (so it arrives late and is skipped)
+  int reordered = -1;   // written after packet reordered + 1 (put back in order by the reorder window)
+  int late = -1;        // written kReorderWindow + 2 packets late: beyond the window, skipped
   int fragmented = -1;  // split into IP fragments of at most 576 bytes
   bool nanoseconds = false;
   std::vector<std::uint8_t> difop;  // RS-16: a DIFOP packet captured before the data (port 7788)
@@ -94,6 +95,10 @@ std::string writeRecording(const SyntheticLidar& lidar, const Recording& r) {
     const auto at = std::find(order.begin(), order.end(), r.reordered);
     std::iter_swap(at, at + 1);
   }
+  if (r.late >= 0) {
+    order.erase(std::find(order.begin(), order.end(), r.late));
+    order.insert(std::find(order.begin(), order.end(), r.late + static_cast<int>(kReorderWindow) + 2) + 1, r.late);
+  }
   if (!r.difop.empty()) pcap.writeUdp(datagram(captureNs(lidar, 0) - 1000000, kSensorIp, 7788, r.difop));
   for (int k : order) {
     const std::int64_t t = captureNs(lidar, k);
@@ -144,7 +149,7 @@ void expectPointsMatchTruth(const SyntheticLidar& lidar, const Recording& r, con
   std::vector<std::vector<Truth>> by_ring(16);
   std::size_t expected = 0;
   for (int k = 0; k < r.packets; ++k) {
-    if (k == r.lost) continue;
+    if (k == r.lost || k == r.late) continue;
     std::vector<TruthFiring> truth;
     lidar.packet(k, &truth);
     for (const TruthFiring& f : truth) {
@@ -261,6 +266,17 @@ TEST(PcapRecording, Vlp16AnnouncingAnotherProductNeedsTheConfigKey) {
   const Decoded accepted = decode(writeRecording(lidar, r), config);
   EXPECT_EQ(accepted.health.counters.count("unknown_product"), 0u);
   expectPointsMatchTruth(lidar, r, accepted);
+}
+
+TEST(PcapRecording, APacketLaterThanTheReorderWindowIsSkipped) {
+  SyntheticLidar lidar;
+  Recording r;
+  r.packets = 200;
+  r.late = 60;
+  const Decoded d = decode(writeRecording(lidar, r), configOf(lidar));
+  EXPECT_EQ(d.health.counters.at("time_backwards"), 1);
+  ASSERT_GE(d.sweeps.size(), 2u);
+  expectPointsMatchTruth(lidar, r, d);
 }
 
 TEST(PcapRecording, NanosecondFileGivesTheSameSweeps) {
