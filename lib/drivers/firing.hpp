@@ -41,7 +41,8 @@ enum class SensorClock {
 
 struct Firing {
   std::int64_t offset_ns = 0;  // firing time after the packet's first firing (the packet stamp)
-  float azimuth_deg = 0.0f;    // sensor azimuth [0, 360), clockwise from +x
+  float azimuth_deg = 0.0f;    // head azimuth at the firing [0, 360), clockwise from +x (a VLP-32C beam's
+                               // horizontal offset moves its point, not this)
   Eigen::Vector3f p = Eigen::Vector3f::Zero();  // metres, lidar frame; zero when there is no return
   float intensity = 0.0f;      // reflectivity / intensity byte, 0..255
   std::uint16_t ring = 0;      // beam index by elevation, 0 = lowest

@@ -2,6 +2,7 @@
 
 #include "drivers/rs16_decoder.hpp"
 #include "drivers/vlp16_decoder.hpp"
+#include "drivers/vlp32_decoder.hpp"
 
 #include <spdlog/spdlog.h>
 
@@ -13,6 +14,11 @@ namespace adit::drivers {
 namespace {
 
 std::array<double, kBeams> elevationTable(const LidarStreamConfig& c) {
+  if (beamsOf(c.model) != kBeams) {
+    if (!c.elevations_deg.empty())
+      throw std::invalid_argument("lidar driver: a vertical angle table is read for 16-beam heads only");
+    return kVlp16ElevationsDeg;  // unused: 32-beam heads carry their own tables
+  }
   if (c.elevations_deg.empty()) return c.model == LidarModel::kVlp16 ? kVlp16ElevationsDeg : kRs16ElevationsDeg;
   if (c.elevations_deg.size() != kBeams)
     throw std::invalid_argument("lidar driver: the elevation table needs 16 angles, got " +
@@ -42,14 +48,49 @@ LidarPacketStream::LidarPacketStream(const LidarStreamConfig& config)
   makeDecoder(elevationTable(config), config.dual_return);
 }
 
+bool packetStampKey(LidarModel model, const std::uint8_t* data, std::size_t size, std::int64_t& key) {
+  if (data == nullptr) return false;
+  if (model == LidarModel::kRs16) {
+    if (size != kRs16PacketSize) return false;
+    const std::uint8_t* t = data + 20;  // year-2000, month, day, hour, minute, second, ms u16, us u16
+    key = ((((((static_cast<std::int64_t>(t[0]) * 12 + t[1]) * 31 + t[2]) * 24 + t[3]) * 60 + t[4]) * 60 + t[5]) *
+           1000000) + ((t[6] << 8) | t[7]) * 1000 + ((t[8] << 8) | t[9]);
+    return true;
+  }
+  if (size != kVlp16PacketSize) return false;
+  key = static_cast<std::int64_t>(data[1200]) | (static_cast<std::int64_t>(data[1201]) << 8) |
+        (static_cast<std::int64_t>(data[1202]) << 16) | (static_cast<std::int64_t>(data[1203]) << 24);
+  return true;
+}
+
+std::int64_t unwrapStampKey(LidarModel model, std::int64_t key, std::int64_t reference) {
+  if (model == LidarModel::kRs16) return key;
+  constexpr std::int64_t kHour = 3600000000LL;
+  std::int64_t d = (key - reference) % kHour;
+  if (d > kHour / 2) d -= kHour;
+  if (d < -kHour / 2) d += kHour;
+  return reference + d;
+}
+
+int beamsOf(LidarModel model) {
+  return model == LidarModel::kVlp32c || model == LidarModel::kHdl32e ? kBeams32 : kBeams;
+}
+
 void LidarPacketStream::makeDecoder(const std::array<double, kBeams>& elevations, bool dual_return) {
   elevations_ = elevations;
   dual_return_ = dual_return;
+  std::vector<std::uint8_t> products;
+  for (int id : config_.accept_product_ids) products.push_back(static_cast<std::uint8_t>(id));
+  if (beamsOf(config_.model) == kBeams32) {
+    const Velodyne32 head = config_.model == LidarModel::kVlp32c ? Velodyne32::kVlp32c : Velodyne32::kHdl32e;
+    firing_table_ = firingTable32(head);
+    auto decoder = std::make_shared<Vlp32Decoder>(head, products);
+    decode_ = [decoder](const std::uint8_t* d, std::size_t n, DecodedPacket& out) { return decoder->decode(d, n, out); };
+    return;
+  }
   firing_table_ = drivers::firingTable(BeamTable::fromElevationsDeg(elevations),
                                        config_.model == LidarModel::kVlp16 ? kVlp16FiringNs : kRs16FiringNs);
   if (config_.model == LidarModel::kVlp16) {
-    std::vector<std::uint8_t> products;
-    for (int id : config_.accept_product_ids) products.push_back(static_cast<std::uint8_t>(id));
     auto decoder = std::make_shared<Vlp16Decoder>(elevations, products);
     decode_ = [decoder](const std::uint8_t* d, std::size_t n, DecodedPacket& out) { return decoder->decode(d, n, out); };
   } else {

@@ -18,7 +18,15 @@
 
 namespace adit::drivers {
 
-enum class LidarModel { kVlp16, kRs16 };
+enum class LidarModel { kVlp16, kRs16, kVlp32c, kHdl32e };
+// Beams of a model's head (16 or 32).
+int beamsOf(LidarModel model);
+// A key that orders a model's data packets by their own stamp (Velodyne: us past the hour, to be compared
+// modulo the hour; RS-16: the header's date and time, monotonic within a month's days), read without decoding;
+// false for a payload of the wrong size.
+bool packetStampKey(LidarModel model, const std::uint8_t* data, std::size_t size, std::int64_t& key);
+// Velodyne stamps wrap every hour: the key of `key` nearest to `reference` (keys of other models unchanged).
+std::int64_t unwrapStampKey(LidarModel model, std::int64_t key, std::int64_t reference);
 
 struct LidarStreamConfig {
   LidarModel model = LidarModel::kVlp16;

@@ -98,7 +98,9 @@ class UdpLidarSource : public runtime::MessageSource {
 LidarModel modelOf(const std::string& name) {
   if (name == "vlp16") return LidarModel::kVlp16;
   if (name == "rs16") return LidarModel::kRs16;
-  throw std::invalid_argument("lidar driver: unknown model '" + name + "' (vlp16 or rs16)");
+  if (name == "vlp32c") return LidarModel::kVlp32c;
+  if (name == "hdl32e") return LidarModel::kHdl32e;
+  throw std::invalid_argument("lidar driver: unknown model '" + name + "' (vlp16, rs16, vlp32c or hdl32e)");
 }
 
 }  // namespace
@@ -130,7 +132,7 @@ std::uint16_t dataPortOf(const UdpLidarConfig& config) {
   if (config.port < 0 || config.port > 65535)
     throw std::invalid_argument("lidar driver: port " + std::to_string(config.port) + " is not a UDP port");
   if (config.port > 0) return static_cast<std::uint16_t>(config.port);
-  return modelOf(config.model) == LidarModel::kVlp16 ? kVlp16DefaultPort : kRs16DefaultPort;
+  return modelOf(config.model) == LidarModel::kRs16 ? kRs16DefaultPort : kVlp16DefaultPort;
 }
 
 LidarStreamConfig streamConfigOf(const UdpLidarConfig& config) {
@@ -152,7 +154,7 @@ LidarStreamConfig streamConfigOf(const UdpLidarConfig& config) {
   s.sweep.max_sweep_duration_s = config.max_sweep_duration_s;
   s.sweep.max_firing_gap_s = config.max_firing_gap_s;
   s.sweep.sensor = config.sensor_name.empty() ? config.model : config.sensor_name;
-  s.sweep.num_beams = kBeams;
+  s.sweep.num_beams = beamsOf(s.model);
   s.accept_product_ids = config.accept_product_ids;
   s.dual_return = config.dual_return;
   return s;

@@ -18,7 +18,7 @@
 namespace adit::drivers {
 
 struct UdpLidarConfig {
-  // lidar_driver.model: "vlp16" or "rs16".
+  // lidar_driver.model: "vlp16", "rs16", "vlp32c" or "hdl32e" (the 32-beam heads: nominal tables only).
   std::string model = "vlp16";
   // lidar_driver.bind_address: IPv4 address to listen on; 0.0.0.0 = all interfaces (the sensors' factory
   // setting broadcasts / sends to the host, either reaches it).
@@ -55,7 +55,7 @@ struct UdpLidarConfig {
   // lidar_driver.difop_port: RS-16 only: the port of the DIFOP packets (recordings; 0 = 7788).
   int difop_port = 0;
   // lidar_driver.sensor_address: recordings (pcap): only datagrams from this IPv4 address are the sensor's;
-  // "" = the first host that sends a valid packet to the data port.
+  // "" = the first host that sends a packet of the model's size to the data port.
   std::string sensor_address;
   // lidar_driver.idle_timeout_s: next() reports the end after this long without a packet (s); 0 = wait
   // for the sensor forever (stops only on SIGINT/SIGTERM).

@@ -88,6 +88,18 @@ bool CaptureReader::readExact(std::uint8_t* out, std::size_t n) {
   return static_cast<std::size_t>(in_.gcount()) == n;
 }
 
+bool CaptureReader::readAppending(std::vector<std::uint8_t>& out, std::size_t n) {
+  // In steps, so that a length the file does not back costs no more memory than the bytes it holds.
+  constexpr std::size_t kStep = 64 * 1024;
+  while (n > 0) {
+    const std::size_t step = std::min(n, kStep), at = out.size();
+    out.resize(at + step);
+    if (!readExact(out.data() + at, step)) return false;
+    n -= step;
+  }
+  return true;
+}
+
 std::uint16_t CaptureReader::u16(const std::uint8_t* p) const {
   return swapped_ ? static_cast<std::uint16_t>((p[0] << 8) | p[1]) : static_cast<std::uint16_t>(p[0] | (p[1] << 8));
 }
@@ -124,8 +136,8 @@ bool CaptureReader::nextClassic(CapturedFrame& frame) {
     damage("corrupt_record", where + ": captured length " + std::to_string(captured) + " bytes is not plausible");
     return false;
   }
-  frame.bytes.resize(captured);
-  if (!readExact(frame.bytes.data(), captured)) {
+  frame.bytes.clear();
+  if (!readAppending(frame.bytes, captured)) {
     damage("truncated_record", where + ": " + std::to_string(captured) + " bytes announced, the file ends first");
     return false;
   }
@@ -171,9 +183,7 @@ bool CaptureReader::nextPcapng(CapturedFrame& frame) {
       damage("corrupt_record", where + ": block length " + std::to_string(length) + " is not valid");
       return false;
     }
-    const std::size_t already = body.size();
-    body.resize(length - 8);  // the body and the trailing length copy
-    if (!readExact(body.data() + already, body.size() - already)) {
+    if (!readAppending(body, length - 8 - body.size())) {  // the body and the trailing length copy
       damage("truncated_record", where + ": " + std::to_string(length) + " bytes announced, the file ends first");
       return false;
     }

@@ -68,6 +68,7 @@ class CaptureReader {
   void readInterface(const std::vector<std::uint8_t>& body);
   bool packetFromBlock(std::uint32_t type, const std::vector<std::uint8_t>& body, CapturedFrame& frame);
   bool readExact(std::uint8_t* out, std::size_t n);
+  bool readAppending(std::vector<std::uint8_t>& out, std::size_t n);
   std::uint16_t u16(const std::uint8_t* p) const;
   std::uint32_t u32(const std::uint8_t* p) const;
   void damage(const std::string& counter, const std::string& what);

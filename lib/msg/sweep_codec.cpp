@@ -302,6 +302,7 @@ std::string decodePoints(const adit::lidar_scan_t& m, LidarScan& s) {
 
 int profileBeams(const std::string& sensor) {
   if (sensor == "vlp16" || sensor == "rs16") return 16;
+  if (sensor == "vlp32c" || sensor == "hdl32e") return 32;
   if (sensor == "hdl64") return 64;
   return 0;
 }

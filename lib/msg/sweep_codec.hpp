@@ -36,7 +36,7 @@ double sweepTolerance(double range_m, float range_scale);
 // Decodes a compact sweep. Returns "" on success, else why the message does not fit its sensor profile or
 // format (counts, ranges, firing table, version); `scan` is then unspecified.
 std::string decodeSweep(const adit::lidar_scan_t& m, LidarScan& scan);
-// Beams of a known sensor profile ("vlp16", "rs16": 16; "hdl64": 64), 0 for another name.
+// Beams of a known sensor profile ("vlp16", "rs16": 16; "vlp32c", "hdl32e": 32; "hdl64": 64), 0 for another name.
 int profileBeams(const std::string& sensor);
 
 // Either sweep message from its bytes, for a node's LIDAR_POINTS input (Node::subscribe decodes through it):

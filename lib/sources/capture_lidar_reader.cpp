@@ -4,6 +4,8 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
+
 namespace adit::sources {
 namespace {
 
@@ -23,7 +25,7 @@ drivers::LidarStreamConfig streamConfig(const drivers::UdpLidarConfig& config) {
 }  // namespace
 
 CaptureLidarReader::CaptureLidarReader(std::istream& in, std::string name, const drivers::UdpLidarConfig& config)
-    : name_(std::move(name)), reader_(in, name_), stream_(streamConfig(config)), port_(drivers::dataPortOf(config)) {
+    : name_(std::move(name)), model_(drivers::streamConfigOf(config).model), reader_(in, name_), stream_(streamConfig(config)), port_(drivers::dataPortOf(config)) {
   if (config.model == "rs16") {
     if (config.difop_port < 0 || config.difop_port > 65535)
       throw std::invalid_argument("lidar driver: difop_port " + std::to_string(config.difop_port) + " is not a UDP port");
@@ -41,6 +43,7 @@ bool CaptureLidarReader::read(std::vector<LidarScan>& sweeps) {
   while (sweeps.size() == before) {
     if (finished_) return false;
     if (!reader_.next(frame_)) {
+      while (!window_.empty()) release(sweeps);
       stream_.finish(sweeps);
       finished_ = true;
       break;
@@ -58,22 +61,49 @@ bool CaptureLidarReader::read(std::vector<LidarScan>& sweeps) {
       ++counters_["other_host"];
       continue;
     }
-    const std::int64_t errors_before = stream_.health().errors;
-    stream_.push(datagram_.payload.data(), datagram_.payload.size(), datagram_.time_ns, sweeps);
-    if (!have_sensor_ && stream_.health().errors == errors_before) {
+    hold(sweeps);
+  }
+  return sweeps.size() > before || !finished_;
+}
+
+void CaptureLidarReader::hold(std::vector<LidarScan>& sweeps) {
+  std::int64_t key = 0;
+  if (!drivers::packetStampKey(model_, datagram_.payload.data(), datagram_.payload.size(), key)) {
+    // No stamp to order by (a wrong size): after everything held, so the stream counts it in turn.
+    key = window_.empty() ? reference_key_ : window_.back().key;
+  } else {
+    if (!have_reference_) {
+      reference_key_ = key;
+      have_reference_ = true;
+    }
+    if (!have_sensor_) {  // the first packet of the sensor's size names the sensor
       have_sensor_ = true;
       sensor_ip_ = datagram_.src_ip;
       spdlog::info("capture '{}': lidar packets from {} to port {}", name_, io::ipv4ToString(sensor_ip_), port_);
     }
+    key = drivers::unwrapStampKey(model_, key, reference_key_);
   }
-  return sweeps.size() > before || !finished_;
+  auto at = std::upper_bound(window_.begin(), window_.end(), key, [](std::int64_t k, const Held& h) { return k < h.key; });
+  if (at != window_.end()) ++counters_["reordered"];
+  window_.insert(at, Held{key, datagram_});
+  if (window_.size() > kReorderWindow) release(sweeps);
+}
+
+void CaptureLidarReader::release(std::vector<LidarScan>& sweeps) {
+  const Held held = std::move(window_.front());
+  window_.pop_front();
+  reference_key_ = held.key;
+  stream_.push(held.datagram.payload.data(), held.datagram.payload.size(), held.datagram.time_ns, sweeps);
 }
 
 runtime::Health CaptureLidarReader::health() const {
   runtime::Health h = stream_.health();
   const auto add = [&h](const std::map<std::string, std::int64_t>& counters) {
     for (const auto& [name, n] : counters) {
-      if (name == "frames" || name == "fragments" || name == "reassembled") continue;  // not problems
+      if (name == "frames" || name == "fragments" || name == "reassembled" || name == "reordered") {
+        if (name == "reordered") h.counters[name] += n;  // an event, not a problem
+        continue;
+      }
       h.counters[name] += n;
       if (isDamage(name)) h.errors += n;
     }

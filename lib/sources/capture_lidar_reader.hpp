@@ -7,10 +7,12 @@
 // the sensor's stamps are unusable (an RS-16 whose clock was never set) the capture times are used instead
 // (counter host_time_fallback); time_source host uses the capture times throughout.
 // Filtering: datagrams to another port (other_port) or from another host than the sensor (other_host) are
-// skipped and counted; the sensor is lidar_driver.sensor_address, or else the first host that sent a valid
-// packet to the data port. At the end of the capture the sweep in progress is published flagged partial.
+// skipped and counted; the sensor is lidar_driver.sensor_address, or else the first host that sent a packet of
+// the model's size to the data port. At the end of the capture the sweep in progress is published flagged partial.
 // Damage in the file (truncated or corrupt records, cut frames, lost fragments) is counted and skipped.
-// A packet that arrives after a later one (reordered) is counted as time_backwards and skipped, as live.
+// Reordering: the data packets pass a window of kReorderWindow packets that releases them in the order of their
+// own stamps (counter reordered), so a packet captured up to that many places late is still used; one later than
+// that is counted as time_backwards and skipped, as live.
 // RS-16: DIFOP packets (lidar_driver.difop_port, default 7788) set the return mode and calibrated angles.
 #pragma once
 
@@ -20,12 +22,15 @@
 #include "io/udp_capture.hpp"
 #include "runtime/health.hpp"
 
+#include <deque>
 #include <istream>
 #include <map>
 #include <string>
 #include <vector>
 
 namespace adit::sources {
+
+constexpr std::size_t kReorderWindow = 8;
 
 class CaptureLidarReader {
  public:
@@ -43,7 +48,18 @@ class CaptureLidarReader {
   std::string summary() const;
 
  private:
+  void hold(std::vector<LidarScan>& sweeps);
+  void release(std::vector<LidarScan>& sweeps);
+
+  struct Held {
+    std::int64_t key;  // stamp key, unwrapped against the last released packet
+    io::UdpDatagram datagram;
+  };
   std::string name_;
+  drivers::LidarModel model_;
+  std::deque<Held> window_;  // sorted by key
+  bool have_reference_ = false;
+  std::int64_t reference_key_ = 0;
   io::CaptureReader reader_;
   io::UdpExtractor extractor_;
   drivers::LidarPacketStream stream_;

@@ -106,10 +106,20 @@ std::unique_ptr<runtime::MessageSource> makeKittiSource(const std::string& seque
                                                         int num_beams) {
   auto sequence = std::make_shared<io::KittiSequence>(sequence_dir);
   if (num_beams == 0 && sequence->size() > 0) {
-    num_beams = io::detectBeamCount(io::readKittiBin(sequence->scanFiles().front()));
-    if (num_beams == 0) throw io::ReadError("KITTI: cannot tell the beam count of '" + sequence->scanFiles().front() +
-                                            "' (neither its scan order nor its elevations show it): give --beams N");
-    spdlog::info("KITTI: {} beams (detected from the first scan)", num_beams);
+    // Detected from the first scan; if that cannot be read or shows no clear fan, KITTI's own 64 (the reading
+    // of each scan reports a bad file in its turn).
+    const std::string& first = sequence->scanFiles().front();
+    try {
+      num_beams = io::detectBeamCount(io::readKittiBin(first));
+    } catch (const io::ReadError&) {
+      num_beams = 0;
+    }
+    if (num_beams == 0) {
+      num_beams = io::kKittiNumBeams;
+      spdlog::warn("KITTI: the beam count does not show in '{}': {} assumed (--beams N sets it)", first, num_beams);
+    } else {
+      spdlog::info("KITTI: {} beams (detected from the first scan; --beams N sets it)", num_beams);
+    }
   }
   if (num_beams > 0) sequence->setNumBeams(num_beams);
   return std::make_unique<ScanFileSource>(sequence->size(), [sequence](std::size_t i) { return sequence->scan(i); },

@@ -12,7 +12,8 @@
 namespace adit::sources {
 
 // KITTI odometry layout: <dir> is sequences/NN (velodyne/*.bin, times.txt, calib.txt). num_beams: of the sensor
-// that wrote it; 0 = detected from the first scan (io::detectBeamCount: 64 on KITTI itself).
+// that wrote it; 0 = detected from the first scan (io::detectBeamCount: 64 on KITTI itself; 64 when the first
+// scan shows no clear fan or cannot be read).
 std::unique_ptr<runtime::MessageSource> makeKittiSource(const std::string& sequence_dir, const std::string& channel,
                                                         int num_beams = 0);
 

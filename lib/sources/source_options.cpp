@@ -14,22 +14,24 @@ void addLidarSourceOptions(CLI::App& app, LidarSourceArgs& a, bool kind_position
         ->required()->check(CLI::ExistingPath);
   } else {
     app.add_option("--source", a.kind,
-                   "kitti | pcd | pcap (recorded files) or vlp16 | rs16 (live sensor packets over UDP)")
-        ->required()->check(CLI::IsMember({"kitti", "pcd", "pcap", "vlp16", "rs16"}));
+                   "kitti | pcd | pcap (recorded files) or vlp16 | rs16 | vlp32c | hdl32e (live sensor packets over UDP)")
+        ->required()->check(CLI::IsMember({"kitti", "pcd", "pcap", "vlp16", "rs16", "vlp32c", "hdl32e"}));
     app.add_option("--path", a.path, "kitti/pcd/pcap: KITTI sequence folder (sequences/NN), folder of PCD files or a "
                    "capture file")->check(CLI::ExistingPath);
   }
   app.add_option("--driver-config", a.driver_configs, "pcap, vlp16/rs16: YAML with lidar_driver.* keys (launch/sensors/)");
   app.add_option("--port", a.port, "pcap, vlp16/rs16: UDP data port (default 2368 / 6699)");
   app.add_option("--channel", a.channel, "Channel of the sweeps");
-  app.add_option("--sensor", a.sensor, "pcap: the sensor that sent the packets (vlp16, rs16); PCD: sensor profile for "
+  app.add_option("--sensor", a.sensor, "pcap: the sensor that sent the packets (vlp16, rs16, vlp32c, hdl32e); PCD: sensor profile for "
                  "rings by elevation (vlp16, rs16, hdl64)");
   app.add_option("--beams", a.beams, "KITTI: beams of the sensor that wrote the folder (default: detected from the "
                  "first scan); PCD: beam count for a uniform fan when the profile is unknown")->check(CLI::Range(0, 255));
   app.add_option("--period", a.period_s, "PCD: sweep period (s) when file names are not timestamps");
 }
 
-bool isLiveSource(const LidarSourceArgs& a) { return a.kind == "vlp16" || a.kind == "rs16"; }
+bool isLiveSource(const LidarSourceArgs& a) {
+  return a.kind == "vlp16" || a.kind == "rs16" || a.kind == "vlp32c" || a.kind == "hdl32e";
+}
 
 std::unique_ptr<runtime::MessageSource> makeLidarSource(const LidarSourceArgs& a) {
   if (isLiveSource(a)) {

@@ -11,7 +11,7 @@
 namespace adit::sources {
 
 struct LidarSourceArgs {
-  std::string kind;   // "kitti", "pcd", "pcap" (recorded) or "vlp16", "rs16" (live UDP packets)
+  std::string kind;   // "kitti", "pcd", "pcap" (recorded) or "vlp16", "rs16", "vlp32c", "hdl32e" (live UDP packets)
   std::string path;   // sequence folder, PCD folder or capture file
   std::vector<std::string> driver_configs;  // live and pcap: YAML with lidar_driver.* keys
   int port = 0;                              // live and pcap: UDP port (0 = the sensor's default)

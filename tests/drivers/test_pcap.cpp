@@ -1,6 +1,6 @@
 // Recorded captures -> sweeps (CaptureLidarReader: capture reader, UDP extraction, the live driver's
 // LidarPacketStream): a pcap written from the synthetic lidar's known firings, with a lost packet, a reordered
-// pair, a fragmented datagram and foreign traffic, decodes to those firings (position within 1 mm, ring exact,
+// pair (put back in order), a fragmented datagram and foreign traffic, decodes to those firings (position within 1 mm, ring exact,
 // time to the sensor stamp's microsecond); the last revolution comes out flagged partial.
 #include "io/capture_writer.hpp"
 #include "msg/sweep_codec.hpp"
@@ -34,7 +34,8 @@ constexpr std::uint32_t kSensorIp = 0xC0A801C9, kHostIp = 0xC0A80164, kOtherIp =
 struct Recording {
   int packets = 0;
   int lost = -1;        // never written
-  int reordered = -1;   // written after packet reordered + 1 (so it arrives late and is skipped)
+  int reordered = -1;   // written after packet reordered + 1 (put back in order by the reorder window)
+  int late = -1;        // written kReorderWindow + 2 packets late: beyond the window, skipped
   int fragmented = -1;  // split into IP fragments of at most 576 bytes
   bool nanoseconds = false;
   std::vector<std::uint8_t> difop;  // RS-16: a DIFOP packet captured before the data (port 7788)
@@ -94,6 +95,10 @@ std::string writeRecording(const SyntheticLidar& lidar, const Recording& r) {
     const auto at = std::find(order.begin(), order.end(), r.reordered);
     std::iter_swap(at, at + 1);
   }
+  if (r.late >= 0) {
+    order.erase(std::find(order.begin(), order.end(), r.late));
+    order.insert(std::find(order.begin(), order.end(), r.late + static_cast<int>(kReorderWindow) + 2) + 1, r.late);
+  }
   if (!r.difop.empty()) pcap.writeUdp(datagram(captureNs(lidar, 0) - 1000000, kSensorIp, 7788, r.difop));
   for (int k : order) {
     const std::int64_t t = captureNs(lidar, k);
@@ -133,7 +138,7 @@ Decoded decode(const std::string& bytes, const drivers::UdpLidarConfig& config) 
   return d;
 }
 
-// Every point of every sweep is a distinct truth return of a packet that was kept, at its time (to the
+// Every point of every sweep is a distinct truth return of a packet that was captured, at its time (to the
 // microsecond of the sensor stamps) and position (1 mm), with its ring; and every such return after the first
 // pass of the cut angle is there.
 void expectPointsMatchTruth(const SyntheticLidar& lidar, const Recording& r, const Decoded& d) {
@@ -144,7 +149,7 @@ void expectPointsMatchTruth(const SyntheticLidar& lidar, const Recording& r, con
   std::vector<std::vector<Truth>> by_ring(16);
   std::size_t expected = 0;
   for (int k = 0; k < r.packets; ++k) {
-    if (k == r.lost || k == r.reordered) continue;
+    if (k == r.lost || k == r.late) continue;
     std::vector<TruthFiring> truth;
     lidar.packet(k, &truth);
     for (const TruthFiring& f : truth) {
@@ -203,7 +208,8 @@ TEST_P(PcapRecording, DecodesToTheKnownFiringsDespiteLossReorderAndFragments) {
   EXPECT_TRUE(d.sweeps[3].partial);
   expectPointsMatchTruth(lidar, r, d);
   EXPECT_EQ(d.health.inputs, r.packets - 1);  // the lost one
-  EXPECT_EQ(d.health.counters.at("time_backwards"), 1);
+  EXPECT_EQ(d.health.counters.at("reordered"), 1);  // put back in place: nothing skipped
+  EXPECT_EQ(d.health.counters.count("time_backwards"), 0u);
   EXPECT_EQ(d.health.counters.at("other_port"), 1);
   EXPECT_EQ(d.health.counters.at("other_host"), 1);
   EXPECT_EQ(d.health.counters.at("not_ipv4"), 1);
@@ -253,12 +259,24 @@ TEST(PcapRecording, Vlp16AnnouncingAnotherProductNeedsTheConfigKey) {
   r.mutate = [](std::vector<std::uint8_t>& p) { p[1205] = 0x24; };
   const Decoded refused = decode(writeRecording(lidar, r), configOf(lidar));
   EXPECT_TRUE(refused.sweeps.empty());
-  EXPECT_EQ(refused.health.counters.at("unknown_product"), r.packets + 1);  // + the other host's copy
+  EXPECT_EQ(refused.health.counters.at("unknown_product"), r.packets);
+  EXPECT_EQ(refused.health.counters.at("other_host"), 1);
   drivers::UdpLidarConfig config = configOf(lidar);
   config.accept_product_ids = {0x24};
   const Decoded accepted = decode(writeRecording(lidar, r), config);
   EXPECT_EQ(accepted.health.counters.count("unknown_product"), 0u);
   expectPointsMatchTruth(lidar, r, accepted);
+}
+
+TEST(PcapRecording, APacketLaterThanTheReorderWindowIsSkipped) {
+  SyntheticLidar lidar;
+  Recording r;
+  r.packets = 200;
+  r.late = 60;
+  const Decoded d = decode(writeRecording(lidar, r), configOf(lidar));
+  EXPECT_EQ(d.health.counters.at("time_backwards"), 1);
+  ASSERT_GE(d.sweeps.size(), 2u);
+  expectPointsMatchTruth(lidar, r, d);
 }
 
 TEST(PcapRecording, NanosecondFileGivesTheSameSweeps) {

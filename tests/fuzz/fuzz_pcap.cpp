@@ -1,6 +1,6 @@
 // A pcap / pcapng capture file through what `adit import pcap` and adit-lidar-bridge --source pcap run:
 // capture reader, link layers, IPv4 reassembly, UDP, and the live driver's packet stream (CaptureLidarReader).
-// Input: one byte model (even VLP-16, odd RS-16), then the file.
+// Input: one byte model (0 VLP-16, 1 RS-16, 2 VLP-32C, 3 HDL-32E, modulo 4), then the file.
 #include "io/io_error.hpp"
 #include "sources/capture_lidar_reader.hpp"
 
@@ -13,7 +13,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   (void)quiet;
   if (size < 1) return 0;
   adit::drivers::UdpLidarConfig config;
-  config.model = data[0] % 2 ? "rs16" : "vlp16";
+  static const char* const kModels[] = {"vlp16", "rs16", "vlp32c", "hdl32e"};
+  config.model = kModels[data[0] % 4];
   std::istringstream in(std::string(reinterpret_cast<const char*>(data + 1), size - 1));
   try {
     adit::sources::CaptureLidarReader reader(in, "fuzz.pcap", config);
