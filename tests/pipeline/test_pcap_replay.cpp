@@ -96,6 +96,11 @@ TEST(PcapReplay, SameAccuracyAsTheSimulatorsLog) {
   std::stable_sort(from_pcap.begin(), from_pcap.end(),
                    [](const auto& a, const auto& b) { return a.utime < b.utime; });
 
+  // The capture's first revolution begins at the first packet, which the driver cannot know is a cut: it is
+  // dropped as live. Both runs start at the same sweep, so that what is compared is the capture, not a start.
+  const auto first_sweep = std::find_if(logged.begin(), logged.end(),
+                                        [](const runtime::OutgoingMessage& m) { return m.channel == "LIDAR_POINTS"; });
+  if (first_sweep != logged.end()) logged.erase(first_sweep);
   const ReplayRun log_run = replay(logged, source.groundTruth(), "log");
   const ReplayRun pcap_run = replay(from_pcap, source.groundTruth(), "pcap");
   std::printf("%lld packets; sweeps: log %lld, pcap %lld; APE rmse: log %.4f m, pcap %.4f m (%+.1f %%)\n",
@@ -103,10 +108,11 @@ TEST(PcapReplay, SameAccuracyAsTheSimulatorsLog) {
               static_cast<long long>(pcap_run.sweeps), log_run.ape_rmse_m, pcap_run.ape_rmse_m,
               100.0 * (pcap_run.ape_rmse_m / log_run.ape_rmse_m - 1.0));
   EXPECT_EQ(health.errors, 0);
-  // The first revolution of the capture begins at the first packet, which the driver cannot know is a cut:
-  // it is dropped as live; every later one is there, the last flagged partial.
-  EXPECT_EQ(pcap_run.sweeps, log_run.sweeps - 1);
-  EXPECT_LE(std::abs(pcap_run.ape_rmse_m - log_run.ape_rmse_m), 0.05 * log_run.ape_rmse_m);
+  // Every revolution after the first is there, the last flagged partial.
+  EXPECT_EQ(pcap_run.sweeps, log_run.sweeps);
+  // Reaches the log's accuracy: at most 5 % worse. (Better is no defect of the capture path: the packets'
+  // 2 mm range steps and the per-firing times give the pipeline slightly different points, measured -4.9 %.)
+  EXPECT_LE(pcap_run.ape_rmse_m, 1.05 * log_run.ape_rmse_m);
 }
 
 }  // namespace
