@@ -110,3 +110,29 @@ bool assignRingsByScanOrder(std::vector<LidarPoint>& points, int num_beams, int 
 }
 
 }  // namespace adit::io
+
+namespace adit::io {
+
+bool orientRingsBottomUp(std::vector<LidarPoint>& points) {
+  int lo = 65536, hi = -1;
+  for (const LidarPoint& p : points) {
+    lo = std::min<int>(lo, p.ring);
+    hi = std::max<int>(hi, p.ring);
+  }
+  if (hi <= lo) return false;
+  double sum_lo = 0.0, sum_hi = 0.0;
+  int n_lo = 0, n_hi = 0;
+  for (const LidarPoint& p : points) {
+    if (p.ring != lo && p.ring != hi) continue;
+    const double horizontal = std::hypot(p.p.x(), p.p.y());
+    if (!p.p.allFinite() || (horizontal == 0.0 && p.p.z() == 0.0f)) continue;
+    const double elevation = std::atan2(static_cast<double>(p.p.z()), horizontal);
+    (p.ring == lo ? sum_lo : sum_hi) += elevation;
+    ++(p.ring == lo ? n_lo : n_hi);
+  }
+  if (n_lo == 0 || n_hi == 0 || sum_lo / n_lo <= sum_hi / n_hi) return false;
+  for (LidarPoint& p : points) p.ring = static_cast<std::uint16_t>(hi - p.ring);
+  return true;
+}
+
+}  // namespace adit::io

@@ -47,4 +47,10 @@ RingAssignmentStats assignRingsByElevation(std::vector<LidarPoint>& points, cons
 // and returns true; otherwise leaves the points unchanged and returns false (caller falls back).
 bool assignRingsByScanOrder(std::vector<LidarPoint>& points, int num_beams, int min_row_points = 10);
 
+// Ring fields number beams either from the bottom (Velodyne, adit's convention) or from the top (Ouster:
+// channel 0 is the highest beam). If the lowest ring number's points lie higher on average than the
+// highest ring number's, renumbers ring -> max_ring - ring and returns true. Points at the origin or
+// non-finite are ignored; with fewer than two distinct rings nothing changes.
+bool orientRingsBottomUp(std::vector<LidarPoint>& points);
+
 }  // namespace adit::io
