@@ -3,14 +3,18 @@
 #include "drivers/udp_lidar_source.hpp"
 #include "runtime/process.hpp"
 #include "sources/file_sources.hpp"
+#include "sources/rosbag_source.hpp"
 
 namespace adit::sources {
 
 void addLidarSourceOptions(CLI::App& app, LidarSourceArgs& a, bool kind_positional) {
   if (kind_positional) {
-    app.add_option("kind", a.kind, "Data set kind: kitti | pcd")->required()->check(CLI::IsMember({"kitti", "pcd"}));
-    app.add_option("path", a.path, "KITTI sequence folder (sequences/NN) or folder of PCD files")
-        ->required()->check(CLI::ExistingDirectory);
+    app.add_option("kind", a.kind, "Data set kind: kitti | pcd | rosbag")
+        ->required()->check(CLI::IsMember({"kitti", "pcd", "rosbag"}));
+    app.add_option("path", a.path, "KITTI sequence folder (sequences/NN), folder of PCD files or ROS 1 bag file")
+        ->required()->check(CLI::ExistingPath);
+    app.add_option("--lidar-topic", a.lidar_topic, "rosbag: the sensor_msgs/PointCloud2 topic (required)");
+    app.add_option("--imu-topic", a.imu_topic, "rosbag: a sensor_msgs/Imu topic to import as IMU");
   } else {
     app.add_option("--source", a.kind, "kitti | pcd (recorded files) or vlp16 | rs16 (live sensor packets over UDP)")
         ->required()->check(CLI::IsMember({"kitti", "pcd", "vlp16", "rs16"}));
@@ -20,9 +24,9 @@ void addLidarSourceOptions(CLI::App& app, LidarSourceArgs& a, bool kind_position
     app.add_option("--port", a.port, "vlp16/rs16: UDP data port (default 2368 / 6699)");
   }
   app.add_option("--channel", a.channel, "Channel of the sweeps");
-  app.add_option("--sensor", a.sensor, "PCD: sensor profile for rings by elevation (vlp16, rs16, hdl64)");
-  app.add_option("--beams", a.beams, "PCD: beam count for a uniform fan when the profile is unknown");
-  app.add_option("--period", a.period_s, "PCD: sweep period (s) when file names are not timestamps");
+  app.add_option("--sensor", a.sensor, "PCD/rosbag: sensor profile for rings by elevation (vlp16, rs16, hdl64)");
+  app.add_option("--beams", a.beams, "PCD/rosbag: beam count for a uniform fan when the profile is unknown");
+  app.add_option("--period", a.period_s, "PCD: sweep period (s) when file names are not timestamps; rosbag: sweep period");
 }
 
 bool isLiveSource(const LidarSourceArgs& a) { return a.kind == "vlp16" || a.kind == "rs16"; }
@@ -37,14 +41,20 @@ std::unique_ptr<runtime::MessageSource> makeLidarSource(const LidarSourceArgs& a
   }
   if (a.path.empty()) throw std::runtime_error("--path is required for a " + a.kind + " source");
   if (a.kind == "kitti") return makeKittiSource(a.path, a.channel);
-  if (a.kind == "pcd") {
-    io::PcdFolderConfig config;
-    config.sensor = a.sensor;
-    config.num_beams = a.beams;
-    config.sweep_duration = a.period_s;
-    return makePcdSource(a.path, config, a.channel);
+  io::PcdFolderConfig cloud;
+  cloud.sensor = a.sensor;
+  cloud.num_beams = a.beams;
+  cloud.sweep_duration = a.period_s;
+  if (a.kind == "pcd") return makePcdSource(a.path, cloud, a.channel);
+  if (a.kind == "rosbag") {
+    RosbagSourceConfig config;
+    config.lidar_topic = a.lidar_topic;
+    config.imu_topic = a.imu_topic;
+    config.lidar_channel = a.channel;
+    config.cloud = cloud;
+    return makeRosbagSource(a.path, config);
   }
-  throw std::runtime_error("unknown source kind '" + a.kind + "' (kitti or pcd)");
+  throw std::runtime_error("unknown source kind '" + a.kind + "' (kitti, pcd or rosbag)");
 }
 
 }  // namespace adit::sources

@@ -1,4 +1,5 @@
 // adit import kitti <sequence_dir> -o <log>   |   adit import pcd <dir> -o <log>
+// adit import rosbag <file.bag> --lidar-topic T [--imu-topic T] -o <log>
 #include "commands.hpp"
 
 #include "runtime/source.hpp"
@@ -7,7 +8,7 @@
 void registerImportCommand(CLI::App& app) {
   auto source = std::make_shared<adit::sources::LidarSourceArgs>();
   auto output = std::make_shared<std::string>();
-  auto* cmd = app.add_subcommand("import", "Convert a data set (KITTI odometry layout, PCD folder) into an LCM log");
+  auto* cmd = app.add_subcommand("import", "Convert a data set (KITTI odometry layout, PCD folder, ROS 1 bag) into an LCM log");
   addLidarSourceOptions(*cmd, *source, true);
   cmd->add_option("-o,--output", *output, "LCM log to write")->required();
   auto keep_going = std::make_shared<bool>(false);

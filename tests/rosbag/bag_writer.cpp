@@ -25,8 +25,14 @@ std::string compress(const std::string& how, const std::string& plain) {
     return out;
   }
   if (how == "lz4") {
-    std::string out(LZ4F_compressFrameBound(plain.size(), nullptr), '\0');
-    const std::size_t n = LZ4F_compressFrame(out.data(), out.size(), plain.data(), plain.size(), nullptr);
+    // The frame options roslz4 (rosbag's lz4 writer) uses: independent 1 MB blocks, no block checksums, a
+    // content checksum, no content size.
+    LZ4F_preferences_t prefs{};
+    prefs.frameInfo.blockSizeID = LZ4F_max1MB;
+    prefs.frameInfo.blockMode = LZ4F_blockIndependent;
+    prefs.frameInfo.contentChecksumFlag = LZ4F_contentChecksumEnabled;
+    std::string out(LZ4F_compressFrameBound(plain.size(), &prefs), '\0');
+    const std::size_t n = LZ4F_compressFrame(out.data(), out.size(), plain.data(), plain.size(), &prefs);
     if (LZ4F_isError(n)) throw std::runtime_error("lz4 compression failed");
     out.resize(n);
     return out;
