@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <map>
 
 namespace adit::io {
 namespace {
@@ -113,24 +115,28 @@ bool assignRingsByScanOrder(std::vector<LidarPoint>& points, int num_beams, int 
 
 namespace adit::io {
 
+// Fewer distinct rings than this say nothing reliable about the numbering's direction.
+constexpr std::size_t kMinRingsToOrient = 4;
+
 bool orientRingsBottomUp(std::vector<LidarPoint>& points) {
-  int lo = 65536, hi = -1;
+  std::map<int, std::pair<double, int>> per_ring;  // ring -> (sum of elevations, points)
   for (const LidarPoint& p : points) {
-    lo = std::min<int>(lo, p.ring);
-    hi = std::max<int>(hi, p.ring);
-  }
-  if (hi <= lo) return false;
-  double sum_lo = 0.0, sum_hi = 0.0;
-  int n_lo = 0, n_hi = 0;
-  for (const LidarPoint& p : points) {
-    if (p.ring != lo && p.ring != hi) continue;
     const double horizontal = std::hypot(p.p.x(), p.p.y());
     if (!p.p.allFinite() || (horizontal == 0.0 && p.p.z() == 0.0f)) continue;
-    const double elevation = std::atan2(static_cast<double>(p.p.z()), horizontal);
-    (p.ring == lo ? sum_lo : sum_hi) += elevation;
-    ++(p.ring == lo ? n_lo : n_hi);
+    auto& [sum, n] = per_ring[p.ring];
+    sum += std::atan2(static_cast<double>(p.p.z()), horizontal);
+    ++n;
   }
-  if (n_lo == 0 || n_hi == 0 || sum_lo / n_lo <= sum_hi / n_hi) return false;
+  // Only a clear top-down numbering is flipped: every ring's mean elevation below the previous ring's.
+  // Rings that are not ordered by elevation at all (a synthetic or permuted numbering) stay as they are.
+  if (per_ring.size() < kMinRingsToOrient) return false;
+  double previous = std::numeric_limits<double>::infinity();
+  for (const auto& [ring, sum_n] : per_ring) {
+    const double mean = sum_n.first / sum_n.second;
+    if (!(mean < previous)) return false;
+    previous = mean;
+  }
+  const int hi = per_ring.rbegin()->first;
   for (LidarPoint& p : points) p.ring = static_cast<std::uint16_t>(hi - p.ring);
   return true;
 }

@@ -48,9 +48,9 @@ RingAssignmentStats assignRingsByElevation(std::vector<LidarPoint>& points, cons
 bool assignRingsByScanOrder(std::vector<LidarPoint>& points, int num_beams, int min_row_points = 10);
 
 // Ring fields number beams either from the bottom (Velodyne, adit's convention) or from the top (Ouster:
-// channel 0 is the highest beam). If the lowest ring number's points lie higher on average than the
-// highest ring number's, renumbers ring -> max_ring - ring and returns true. Points at the origin or
-// non-finite are ignored; with fewer than two distinct rings nothing changes.
+// channel 0 is the highest beam). If each ring's mean elevation lies below the previous ring's (at least
+// 4 rings), renumbers ring -> max_ring - ring and returns true; any other order is left alone. Points at
+// the origin or non-finite are ignored.
 bool orientRingsBottomUp(std::vector<LidarPoint>& points);
 
 }  // namespace adit::io
