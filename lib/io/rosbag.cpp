@@ -144,7 +144,7 @@ BagReader::BagReader(const std::string& path) : path_(path) {
   std::uint64_t index_pos = 0;
   if (!readTopLevel(header) || header.op != kBagHeader || !field(header.fields, "index_pos", index_pos)) {
     std::fclose(file_);
-    throw ReadError("bag '" + path + "': " + (stats_.last_error.empty() ? "no bag header record" : stats_.last_error));
+    throw ReadError(stats_.last_error.empty() ? "bag '" + path + "': no bag header record" : stats_.last_error);
   }
   readTrailingConnections(index_pos);
 }

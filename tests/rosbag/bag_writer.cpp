@@ -69,11 +69,19 @@ void BagWriter::addMessage(std::uint32_t conn, std::int64_t time_ns, const Bytes
   chunk_ += record(h, std::string(data.begin(), data.end()));
 }
 
+// The bag header record: its data pads header + data to padding_ bytes, so its size does not depend on index_pos.
+std::string BagWriter::bagHeaderRecord(std::uint64_t index_pos) const {
+  const std::string h = fieldOf("chunk_count", u32(static_cast<std::uint32_t>(chunks_))) +
+                        fieldOf("conn_count", u32(static_cast<std::uint32_t>(conns_.size()))) +
+                        fieldOf("index_pos", u64(index_pos)) + fieldOf("op", "\x03");
+  return record(h, std::string(padding_ > h.size() ? padding_ - h.size() : 0, ' '));
+}
+
 std::pair<std::size_t, std::size_t> BagWriter::endChunk() {
   if (chunk_.empty()) return {0, 0};
   const std::string data = compress(compression_, chunk_);
   const std::string h = fieldOf("compression", compression_) + fieldOf("op", "\x05") + fieldOf("size", u32(static_cast<std::uint32_t>(chunk_.size())));
-  const std::size_t begin = 13 + 4096 + 8 + body_.size() + 4 + h.size() + 4;  // after version line and bag header record
+  const std::size_t begin = 13 + bagHeaderRecord(0).size() + body_.size() + 4 + h.size() + 4;
   body_ += record(h, data);
   chunk_.clear();
   in_chunk_.assign(conns_.size(), false);
@@ -83,15 +91,8 @@ std::pair<std::size_t, std::size_t> BagWriter::endChunk() {
 
 std::string BagWriter::finish() {
   endChunk();
-  std::string bag_header_fields = fieldOf("chunk_count", u32(static_cast<std::uint32_t>(chunks_))) +
-                                  fieldOf("conn_count", u32(static_cast<std::uint32_t>(conns_.size()))) +
-                                  fieldOf("op", "\x03");
-  // The bag header record is 4096 bytes + its two lengths, so index_pos is known before it is written.
-  const std::string index_field_probe = fieldOf("index_pos", u64(0));
-  const std::size_t header_size = bag_header_fields.size() + index_field_probe.size();
-  const std::uint64_t index_pos = 13 + 8 + 4096 + body_.size();
-  const std::string h = fieldOf("index_pos", u64(index_pos)) + bag_header_fields;
-  std::string out = "#ROSBAG V2.0\n" + record(h, std::string(4096 - header_size, ' ')) + body_;
+  const std::uint64_t index_pos = 13 + bagHeaderRecord(0).size() + body_.size();
+  std::string out = "#ROSBAG V2.0\n" + bagHeaderRecord(index_pos) + body_;
   for (const Conn& c : conns_) out += connectionRecord(c);
   return out;
 }

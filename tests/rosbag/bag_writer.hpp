@@ -16,7 +16,9 @@ using Bytes = std::vector<std::uint8_t>;
 class BagWriter {
  public:
   // compression: "none", "bz2" or "lz4" (LZ4 frame format, as roslz4 writes it).
-  explicit BagWriter(std::string compression) : compression_(std::move(compression)) {}
+  // header_padding: rosbag pads the bag header record to 4096 bytes; the fuzz seeds use 0 to stay small.
+  explicit BagWriter(std::string compression, std::size_t header_padding = 4096)
+      : compression_(std::move(compression)), padding_(header_padding) {}
   void addConnection(std::uint32_t id, const std::string& topic, const std::string& type);
   // Appends to the open chunk; the connection's record goes into the chunk before its first message.
   void addMessage(std::uint32_t conn, std::int64_t time_ns, const Bytes& data);
@@ -31,7 +33,9 @@ class BagWriter {
     std::string topic, type;
   };
   std::string connectionRecord(const Conn& c) const;
+  std::string bagHeaderRecord(std::uint64_t index_pos) const;
   std::string compression_;
+  std::size_t padding_;
   std::vector<Conn> conns_;
   std::vector<bool> in_chunk_;
   std::string chunk_, body_;
