@@ -204,8 +204,11 @@ void BagReader::readTrailingConnections(std::uint64_t index_pos) {
   Record r;
   while (readTopLevel(r)) {
     BagConnection c;
+    std::uint64_t chunk_pos = 0;
     if (r.op == kConnection && parseConnection(r.fields, r.data.data(), r.data.size(), c)) connections_[c.id] = c;
+    if (r.op == kChunkInfo && field(r.fields, "chunk_pos", chunk_pos) && chunk_pos < index_pos) chunk_positions_.push_back(chunk_pos);
   }
+  std::sort(chunk_positions_.begin(), chunk_positions_.end());
   stats_ = before;  // a damaged index is not the data's problem: the chunks are still read
   done_ = false;
   pos_ = resume;
@@ -265,6 +268,23 @@ void BagReader::loadChunk(const Record& chunk) {
   for (BagMessage& m : messages) pending_.push_back(std::move(m));
 }
 
+// After a framing break at pos_: jump to the first indexed chunk beyond it, counting the chunks passed over.
+bool BagReader::resynchronise() {
+  const auto next = std::upper_bound(chunk_positions_.begin(), chunk_positions_.end(), pos_);
+  if (next == chunk_positions_.end()) return false;
+  const auto skipped = std::count_if(chunk_positions_.begin(), next, [&](std::uint64_t p) { return p >= pos_; });
+  const std::uint64_t from = pos_;
+  stats_.chunks_lost += skipped;
+  stats_.chunks += skipped;
+  ++stats_.resyncs;
+  stats_.last_error += "; resumed at the next indexed chunk, byte " + std::to_string(*next) + " (" +
+                       std::to_string(*next - from) + " bytes, " + std::to_string(skipped) + " chunk(s) lost)";
+  pos_ = *next;
+  stats_.truncated = false;
+  done_ = false;
+  return true;
+}
+
 bool BagReader::next(BagMessage& message) {
   for (;;) {
     while (!pending_.empty()) {
@@ -278,7 +298,11 @@ bool BagReader::next(BagMessage& message) {
       return true;
     }
     Record r;
-    if (done_ || !readTopLevel(r)) return false;
+    if (done_) return false;
+    if (!readTopLevel(r)) {
+      if (stats_.truncated && resynchronise()) continue;
+      return false;
+    }
     if (r.op == kChunk) {
       loadChunk(r);
     } else if (r.op == kConnection) {

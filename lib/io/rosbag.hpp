@@ -6,17 +6,18 @@
 // 0x03 bag header, 0x05 chunk (fields compression = none|bz2|lz4, size = uncompressed bytes; its data
 // holds connection and message records), 0x07 connection (conn, topic; data = a header with type,
 // md5sum, message_definition), 0x02 message (conn, time = uint32 secs + uint32 nsecs), 0x04 index and
-// 0x06 chunk info (ignored: chunks are read front to back, so an unindexed bag from an interrupted
-// recording reads too). Connection records sit in the chunks and again after the last chunk; the
-// reader collects the trailing copies first, so a message whose chunk-local connection record was lost
-// still finds its topic.
+// 0x06 chunk info (chunks are read front to back, so an unindexed bag from an interrupted recording
+// reads too; the chunk infos only serve to resynchronise, below). Connection records sit in the chunks
+// and again after the last chunk; the reader collects the trailing copies first, so a message whose
+// chunk-local connection record was lost still finds its topic.
 //
 // Bad input: every length is checked against the bytes present before anything is allocated. A chunk
 // that does not decompress, decompresses to another size than it declares, uses an unknown compression
 // or holds malformed records is lost alone (counted in chunks_lost, with the reason in last_error);
 // the next chunk is read. A record header that breaks the framing of the file itself (the chain of
-// top-level lengths) ends the reading there: truncated is set. Only a file that is not a bag at all
-// (missing version line or bag header) throws ReadError.
+// top-level lengths) is skipped to the next chunk the index lists (chunks_lost counts the chunks
+// skipped, resyncs the jumps); without an index entry beyond it the reading ends there: truncated is
+// set. Only a file that is not a bag at all (missing version line or bag header) throws ReadError.
 #pragma once
 
 #include <cstdint>
@@ -47,6 +48,7 @@ struct BagReadStats {
   std::int64_t chunks_lost = 0;   // chunks skipped as corrupt (reason in last_error)
   std::int64_t messages = 0;      // message records returned
   std::int64_t unknown_conn = 0;  // messages of a connection never defined (skipped)
+  std::int64_t resyncs = 0;       // jumps over broken framing to the next indexed chunk
   bool truncated = false;         // the file's record chain broke before its end
   std::string last_error;
 };
@@ -79,10 +81,12 @@ class BagReader {
   void readTrailingConnections(std::uint64_t index_pos);
   void loadChunk(const Record& chunk);
   void breakAt(const std::string& why);
+  bool resynchronise();
 
   std::string path_;
   std::FILE* file_ = nullptr;
   std::uint64_t size_ = 0, pos_ = 0;
+  std::vector<std::uint64_t> chunk_positions_;  // from the index's chunk infos, ascending
   std::map<std::uint32_t, BagConnection> connections_;
   std::deque<BagMessage> pending_;  // messages of the current chunk
   BagReadStats stats_;

@@ -81,7 +81,8 @@ std::pair<std::size_t, std::size_t> BagWriter::endChunk() {
   if (chunk_.empty()) return {0, 0};
   const std::string data = compress(compression_, chunk_);
   const std::string h = fieldOf("compression", compression_) + fieldOf("op", "\x05") + fieldOf("size", u32(static_cast<std::uint32_t>(chunk_.size())));
-  const std::size_t begin = 13 + bagHeaderRecord(0).size() + body_.size() + 4 + h.size() + 4;
+  chunk_pos_.push_back(13 + bagHeaderRecord(0).size() + body_.size());
+  const std::size_t begin = chunk_pos_.back() + 4 + h.size() + 4;
   body_ += record(h, data);
   chunk_.clear();
   in_chunk_.assign(conns_.size(), false);
@@ -94,6 +95,10 @@ std::string BagWriter::finish() {
   const std::uint64_t index_pos = 13 + bagHeaderRecord(0).size() + body_.size();
   std::string out = "#ROSBAG V2.0\n" + bagHeaderRecord(index_pos) + body_;
   for (const Conn& c : conns_) out += connectionRecord(c);
+  for (const std::uint64_t pos : chunk_pos_)  // chunk infos without the per-connection counts (adit ignores them)
+    out += record(fieldOf("op", "\x06") + fieldOf("ver", u32(1)) + fieldOf("chunk_pos", u64(pos)) +
+                      fieldOf("start_time", u64(0)) + fieldOf("end_time", u64(0)) + fieldOf("count", u32(0)),
+                  "");
   return out;
 }
 

@@ -24,8 +24,10 @@ class BagWriter {
   void addMessage(std::uint32_t conn, std::int64_t time_ns, const Bytes& data);
   // Closes the open chunk (no-op if empty). Returns the byte range [begin, end) of the chunk's data.
   std::pair<std::size_t, std::size_t> endChunk();
-  // The whole file: version line, bag header, chunks, trailing connections.
+  // The whole file: version line, bag header, chunks, trailing connections and chunk infos (the index).
   std::string finish();
+  // File offset of each chunk record (valid after finish()).
+  const std::vector<std::uint64_t>& chunkPositions() const { return chunk_pos_; }
 
  private:
   struct Conn {
@@ -40,6 +42,7 @@ class BagWriter {
   std::vector<bool> in_chunk_;
   std::string chunk_, body_;
   int chunks_ = 0;
+  std::vector<std::uint64_t> chunk_pos_;
 };
 
 // One field of a PointCloud2 (datatype: 1 INT8 .. 8 FLOAT64, as sensor_msgs/PointField).

@@ -2,6 +2,7 @@
 // every compression, two driver layouts, IMU; a corrupted chunk; truncated, empty and random files.
 #include <gtest/gtest.h>
 
+#include <cstring>
 #include <fstream>
 #include <random>
 
@@ -33,6 +34,7 @@ struct TestBag {
   std::vector<ImuSample> imu;
   std::vector<std::int64_t> imu_utime;
   std::vector<std::pair<std::size_t, std::size_t>> chunks;
+  std::vector<std::uint64_t> chunk_records;  // file offsets of the chunk records
 };
 
 TestBag makeBag(const std::string& compression) {
@@ -53,6 +55,7 @@ TestBag makeBag(const std::string& compression) {
     if (k % 2) b.chunks.push_back(w.endChunk());
   }
   b.bytes = w.finish();
+  b.chunk_records = w.chunkPositions();
   return b;
 }
 
@@ -144,6 +147,42 @@ TEST(Rosbag, CorruptChunkLosesOnlyThatChunk) {
     expectCloud(r.scans[1], bag.clouds[3]);
     EXPECT_EQ(r.imu.size(), 20u);
   }
+}
+
+TEST(Rosbag, BrokenChunkHeaderIsSkippedThroughTheIndex) {
+  io::test::TempDir dir;
+  TestBag bag = makeBag("bz2");
+  const std::uint32_t huge = 0xFFFFFFF0u;  // the first chunk's header length: the file's framing breaks there
+  std::memcpy(&bag.bytes[bag.chunk_records[0]], &huge, 4);
+  dir.write("run.bag", bag.bytes);
+  const ReadBack r = readBag(dir.file("run.bag"));
+  EXPECT_EQ(r.stats.resyncs, 1);
+  EXPECT_EQ(r.stats.chunks_lost, 1);
+  EXPECT_FALSE(r.stats.truncated);
+  EXPECT_NE(r.stats.last_error.find("resumed at the next indexed chunk"), std::string::npos) << r.stats.last_error;
+  ASSERT_EQ(r.scans.size(), 2u);
+  expectCloud(r.scans[0], bag.clouds[2]);
+  expectCloud(r.scans[1], bag.clouds[3]);
+
+  // Without an index entry beyond the break (the second chunk's header), the reading ends there.
+  TestBag last = makeBag("lz4");
+  std::memcpy(&last.bytes[last.chunk_records[1]], &huge, 4);
+  dir.write("last.bag", last.bytes);
+  const ReadBack l = readBag(dir.file("last.bag"));
+  EXPECT_TRUE(l.stats.truncated);
+  EXPECT_EQ(l.scans.size(), 2u);
+}
+
+TEST(Rosbag, CorruptIndexStillReadsTheChunks) {
+  io::test::TempDir dir;
+  TestBag bag = makeBag("lz4");
+  const std::size_t index = bag.chunks[1].second;  // the trailing connections and chunk infos start here
+  for (std::size_t i = index; i < bag.bytes.size(); i += 3) bag.bytes[i] = static_cast<char>(0xA5);
+  dir.write("run.bag", bag.bytes);
+  const ReadBack r = readBag(dir.file("run.bag"));
+  EXPECT_EQ(r.stats.chunks_lost, 0);
+  EXPECT_EQ(r.scans.size(), 4u);
+  EXPECT_EQ(r.imu.size(), 40u);
 }
 
 TEST(Rosbag, UnknownCompressionLosesTheChunk) {
