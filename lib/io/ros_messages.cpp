@@ -109,7 +109,9 @@ LidarScan decodePointCloud2(const std::uint8_t* data, std::size_t size, const Pc
     if (f.offset > point_step || std::uint64_t{f.size} * f.count > point_step - f.offset)
       throw DecodeError(std::string(what) + ": field '" + f.name + "' lies outside point_step " + std::to_string(point_step));
   const std::uint64_t row_bytes = std::uint64_t{width} * point_step;
-  if (point_step == 0 || row_step < row_bytes || (height > 0 && std::uint64_t{row_step} * (height - 1) + row_bytes > data_size))
+  // Each product is below 2^64 (32-bit factors); compared separately so that no sum can wrap.
+  const bool fits = height == 0 || (row_bytes <= data_size && std::uint64_t{row_step} * (height - 1) <= data_size - row_bytes);
+  if (point_step == 0 || row_step < row_bytes || !fits)
     throw DecodeError(std::string(what) + ": " + std::to_string(height) + " x " + std::to_string(width) + " points of " +
                       std::to_string(point_step) + " bytes (row_step " + std::to_string(row_step) + ") do not fit its " +
                       std::to_string(data_size) + " data bytes");

@@ -302,6 +302,10 @@ TEST(RosMessages, MalformedCloudsAreDecodeErrors) {
   EXPECT_THROW(io::decodePointCloud2(bad_type.data(), bad_type.size(), config, 0), io::DecodeError);
   const Bytes no_z = pointCloud2(kSec, 0, {{"x", 0, 7}, {"y", 4, 7}}, 20, data);
   EXPECT_THROW(io::decodePointCloud2(no_z.data(), no_z.size(), config, 0), io::ReadError);
+  Bytes huge = good.message;  // height 2^32-1 rows over the data of 8 columns
+  const std::uint32_t rows = 0xFFFFFFFFu;
+  std::memcpy(huge.data() + 20, &rows, 4);  // after seq, stamp and the 4-byte frame_id "base"
+  EXPECT_THROW(io::decodePointCloud2(huge.data(), huge.size(), config, 0), io::DecodeError);
   const Bytes imu = imuMessage(kSec, 0, imuAt(1));
   EXPECT_THROW(io::decodeImu(imu.data(), imu.size() - 1, 0), io::DecodeError);
 }
