@@ -118,7 +118,8 @@ LidarScan decodePointCloud2(const std::uint8_t* data, std::size_t size, const Pc
   cloud.point_step = point_step;
   cloud.points = std::size_t{height} * width;
   cloud.data.resize(cloud.points * point_step);  // bounded by data_size, checked above
-  for (std::uint32_t r = 0; r < height; ++r)  // repack: rows may be padded
+  // Repack: rows may be padded. An empty row (width 0) copies nothing, however many rows are declared.
+  for (std::uint32_t r = 0; row_bytes > 0 && r < height; ++r)
     std::memcpy(cloud.data.data() + r * row_bytes, points + std::uint64_t{r} * row_step, row_bytes);
   if (big_endian) swapToLittleEndian(cloud);
 

@@ -306,6 +306,9 @@ TEST(RosMessages, MalformedCloudsAreDecodeErrors) {
   const std::uint32_t rows = 0xFFFFFFFFu;
   std::memcpy(huge.data() + 20, &rows, 4);  // after seq, stamp and the 4-byte frame_id "base"
   EXPECT_THROW(io::decodePointCloud2(huge.data(), huge.size(), config, 0), io::DecodeError);
+  Bytes empty_rows = pointCloud2(kSec, 0, {{"x", 0, 7}, {"y", 4, 7}, {"z", 8, 7}}, 12, Bytes{});  // width 0
+  std::memcpy(empty_rows.data() + 20, &rows, 4);  // ... in 2^32-1 rows: an empty sweep, at once (fuzz finding)
+  EXPECT_TRUE(io::decodePointCloud2(empty_rows.data(), empty_rows.size(), config, 0).points.empty());
   const Bytes imu = imuMessage(kSec, 0, imuAt(1));
   EXPECT_THROW(io::decodeImu(imu.data(), imu.size() - 1, 0), io::DecodeError);
 }
