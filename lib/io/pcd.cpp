@@ -123,9 +123,13 @@ bool pcdStampFromFileName(const std::string& path, std::int64_t& utime) {
 
 LidarScan readPcdScan(const std::string& path, const PcdFolderConfig& config, std::int64_t utime, std::int64_t seq,
                       PcdScanReport* report) {
-  const PcdCloud cloud = readPcdFile(path);
+  return scanFromCloud(readPcdFile(path), config, utime, seq, "PCD: '" + path + "'", report);
+}
+
+LidarScan scanFromCloud(const PcdCloud& cloud, const PcdFolderConfig& config, std::int64_t utime, std::int64_t seq,
+                        const std::string& name, PcdScanReport* report) {
   const FieldReader x = findField(cloud, "x"), y = findField(cloud, "y"), z = findField(cloud, "z");
-  if (!x.present || !y.present || !z.present) throw ReadError("PCD: '" + path + "' has no x, y and z fields");
+  if (!x.present || !y.present || !z.present) throw ReadError(name + " has no x, y and z fields");
   const FieldReader intensity = findField(cloud, "intensity");
   const FieldReader ring = findField(cloud, "ring");
   PcdScanReport local;
@@ -160,6 +164,7 @@ LidarScan readPcdScan(const std::string& path, const PcdFolderConfig& config, st
 
   if (ring.present) {
     local.ring_field = true;
+    local.rings_flipped = orientRingsBottomUp(scan.points);
     scan.has_ring = true;
     scan.num_beams = config.num_beams > 0 ? config.num_beams : max_ring + 1;
   } else {
@@ -169,6 +174,7 @@ LidarScan readPcdScan(const std::string& path, const PcdFolderConfig& config, st
   TimeFill times;
   if (time.present) times = fillTimes(cloud, time, scan.points);
   scan.has_time = times.usable;
+  local.time_max_seconds = times.max_seconds;
   if (times.usable && times.absolute) {
     scan.utime = toUtime(times.max_seconds);
     local.absolute_times = true;

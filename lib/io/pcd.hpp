@@ -2,8 +2,9 @@
 // pcd_format.hpp parses ascii, binary and binary_compressed files and checks every size in the header
 // against the bytes present (PCL's reader trusts the header; a crafted file crashed it).
 //
-// Fields: x, y, z required; intensity optional (else 0). `ring` optional, any integer or float type, taken
-// as 0 = lowest beam. Per-point time optional, the first of `time`, `t`, `timestamp` present:
+// Fields: x, y, z required; intensity optional (else 0). `ring` optional, any integer or float type;
+// numbered from the top beam (Ouster) it is renumbered so that 0 = lowest beam (orientRingsBottomUp).
+// Per-point time optional, the first of `time`, `t`, `timestamp` present:
 //   integer types are nanoseconds (Ouster `t`), float types are seconds (Velodyne `time`, Hesai/RoboSense
 //   `timestamp`); values may be relative (to any origin) or absolute, since dt = value - (largest value),
 //   which puts the last firing at dt = 0 as the adit convention wants. A time field whose values are all
@@ -60,15 +61,23 @@ PcdFolderConfig pcdFolderConfigFrom(const Config& c);
 // What reading one file found (optional out-parameter).
 struct PcdScanReport {
   bool ring_field = false;     // rings came from the file
+  bool rings_flipped = false;  // the field numbered beams from the top (Ouster): renumbered (rings.hpp)
   std::string time_field;      // "time", "t", "timestamp" or empty
   bool absolute_times = false;  // utime came from the per-point times (rule 1)
   int nan_points = 0;          // points with a non-finite coordinate (kept)
   int far_from_beam = 0;       // elevation-assigned points > 1 deg from their beam
+  double time_max_seconds = 0.0;  // the largest per-point time (s) when the scan has times
 };
 
 // Reads one PCD file as a sweep with the given utime/seq (rule 1 may override utime). Throws ReadError.
 LidarScan readPcdScan(const std::string& path, const PcdFolderConfig& config, std::int64_t utime, std::int64_t seq,
                       PcdScanReport* report = nullptr);
+
+struct PcdCloud;
+// The same conversion for a cloud already in memory (a ROS PointCloud2 shares PCD's field model);
+// `name` starts error messages.
+LidarScan scanFromCloud(const PcdCloud& cloud, const PcdFolderConfig& config, std::int64_t utime, std::int64_t seq,
+                        const std::string& name, PcdScanReport* report = nullptr);
 
 // The sweep time a file name encodes (rule 2 above), in utime; false if the name is not a timestamp.
 bool pcdStampFromFileName(const std::string& path, std::int64_t& utime);

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <map>
 
 namespace adit::io {
 namespace {
@@ -171,6 +173,36 @@ bool assignRingsByScanOrder(std::vector<LidarPoint>& points, int num_beams, int 
   const int rows = scanOrderRows(points, min_row_points, row_of);
   if (rows != num_beams) return false;
   for (size_t i = 0; i < points.size(); ++i) points[i].ring = static_cast<std::uint16_t>(num_beams - 1 - row_of[i]);
+  return true;
+}
+
+}  // namespace adit::io
+
+namespace adit::io {
+
+// Fewer distinct rings than this say nothing reliable about the numbering's direction.
+constexpr std::size_t kMinRingsToOrient = 4;
+
+bool orientRingsBottomUp(std::vector<LidarPoint>& points) {
+  std::map<int, std::pair<double, int>> per_ring;  // ring -> (sum of elevations, points)
+  for (const LidarPoint& p : points) {
+    const double horizontal = std::hypot(p.p.x(), p.p.y());
+    if (!p.p.allFinite() || (horizontal == 0.0 && p.p.z() == 0.0f)) continue;
+    auto& [sum, n] = per_ring[p.ring];
+    sum += std::atan2(static_cast<double>(p.p.z()), horizontal);
+    ++n;
+  }
+  // Only a clear top-down numbering is flipped: every ring's mean elevation below the previous ring's.
+  // Rings that are not ordered by elevation at all (a synthetic or permuted numbering) stay as they are.
+  if (per_ring.size() < kMinRingsToOrient) return false;
+  double previous = std::numeric_limits<double>::infinity();
+  for (const auto& [ring, sum_n] : per_ring) {
+    const double mean = sum_n.first / sum_n.second;
+    if (!(mean < previous)) return false;
+    previous = mean;
+  }
+  const int hi = per_ring.rbegin()->first;
+  for (LidarPoint& p : points) p.ring = static_cast<std::uint16_t>(hi - p.ring);
   return true;
 }
 

@@ -59,4 +59,10 @@ std::vector<double> elevationPeaks(const std::vector<LidarPoint>& points);
 // (16, 32, 40, 64, 128), else the elevation peaks if they are 4..128 of them, else 0 (unknown).
 int detectBeamCount(const std::vector<LidarPoint>& points);
 
+// Ring fields number beams either from the bottom (Velodyne, adit's convention) or from the top (Ouster:
+// channel 0 is the highest beam). If each ring's mean elevation lies below the previous ring's (at least
+// 4 rings), renumbers ring -> max_ring - ring and returns true; any other order is left alone. Points at
+// the origin or non-finite are ignored.
+bool orientRingsBottomUp(std::vector<LidarPoint>& points);
+
 }  // namespace adit::io

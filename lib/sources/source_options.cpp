@@ -4,14 +4,18 @@
 #include "runtime/process.hpp"
 #include "sources/file_sources.hpp"
 #include "sources/pcap_source.hpp"
+#include "sources/rosbag_source.hpp"
 
 namespace adit::sources {
 
 void addLidarSourceOptions(CLI::App& app, LidarSourceArgs& a, bool kind_positional) {
   if (kind_positional) {
-    app.add_option("kind", a.kind, "Data set kind: kitti | pcd | pcap")->required()->check(CLI::IsMember({"kitti", "pcd", "pcap"}));
-    app.add_option("path", a.path, "KITTI sequence folder (sequences/NN), folder of PCD files or a .pcap/.pcapng capture")
+    app.add_option("kind", a.kind, "Data set kind: kitti | pcd | pcap | rosbag")
+        ->required()->check(CLI::IsMember({"kitti", "pcd", "pcap", "rosbag"}));
+    app.add_option("path", a.path, "KITTI sequence folder (sequences/NN), folder of PCD files, a .pcap/.pcapng capture or a ROS 1 bag file")
         ->required()->check(CLI::ExistingPath);
+    app.add_option("--lidar-topic", a.lidar_topic, "rosbag: the sensor_msgs/PointCloud2 topic (required)");
+    app.add_option("--imu-topic", a.imu_topic, "rosbag: a sensor_msgs/Imu topic to import as IMU");
   } else {
     app.add_option("--source", a.kind,
                    "kitti | pcd | pcap (recorded files) or vlp16 | rs16 | vlp32c | hdl32e (live sensor packets over UDP)")
@@ -22,11 +26,11 @@ void addLidarSourceOptions(CLI::App& app, LidarSourceArgs& a, bool kind_position
   app.add_option("--driver-config", a.driver_configs, "pcap, vlp16/rs16: YAML with lidar_driver.* keys (launch/sensors/)");
   app.add_option("--port", a.port, "pcap, vlp16/rs16: UDP data port (default 2368 / 6699)");
   app.add_option("--channel", a.channel, "Channel of the sweeps");
-  app.add_option("--sensor", a.sensor, "pcap: the sensor that sent the packets (vlp16, rs16, vlp32c, hdl32e); PCD: sensor profile for "
-                 "rings by elevation (vlp16, rs16, hdl64)");
+  app.add_option("--sensor", a.sensor, "pcap: the sensor that sent the packets (vlp16, rs16, vlp32c, hdl32e); PCD/rosbag: sensor "
+                 "profile for rings by elevation (vlp16, rs16, hdl64)");
   app.add_option("--beams", a.beams, "KITTI: beams of the sensor that wrote the folder (default: detected from the "
-                 "first scan); PCD: beam count for a uniform fan when the profile is unknown")->check(CLI::Range(0, 255));
-  app.add_option("--period", a.period_s, "PCD: sweep period (s) when file names are not timestamps");
+                 "first scan); PCD/rosbag: beam count for a uniform fan when the profile is unknown")->check(CLI::Range(0, 255));
+  app.add_option("--period", a.period_s, "PCD: sweep period (s) when file names are not timestamps; rosbag: sweep period");
 }
 
 bool isLiveSource(const LidarSourceArgs& a) {
@@ -50,14 +54,20 @@ std::unique_ptr<runtime::MessageSource> makeLidarSource(const LidarSourceArgs& a
     return makePcapLidarSource(a.path, config);
   }
   if (a.kind == "kitti") return makeKittiSource(a.path, a.channel, a.beams);
-  if (a.kind == "pcd") {
-    io::PcdFolderConfig config;
-    config.sensor = a.sensor;
-    config.num_beams = a.beams;
-    config.sweep_duration = a.period_s;
-    return makePcdSource(a.path, config, a.channel);
+  io::PcdFolderConfig cloud;
+  cloud.sensor = a.sensor;
+  cloud.num_beams = a.beams;
+  cloud.sweep_duration = a.period_s;
+  if (a.kind == "pcd") return makePcdSource(a.path, cloud, a.channel);
+  if (a.kind == "rosbag") {
+    RosbagSourceConfig config;
+    config.lidar_topic = a.lidar_topic;
+    config.imu_topic = a.imu_topic;
+    config.lidar_channel = a.channel;
+    config.cloud = cloud;
+    return makeRosbagSource(a.path, config);
   }
-  throw std::runtime_error("unknown source kind '" + a.kind + "' (kitti, pcd or pcap)");
+  throw std::runtime_error("unknown source kind '" + a.kind + "' (kitti, pcd, pcap or rosbag)");
 }
 
 }  // namespace adit::sources

@@ -11,8 +11,8 @@
 namespace adit::sources {
 
 struct LidarSourceArgs {
-  std::string kind;   // "kitti", "pcd", "pcap" (recorded) or "vlp16", "rs16", "vlp32c", "hdl32e" (live UDP packets)
-  std::string path;   // sequence folder, PCD folder or capture file
+  std::string kind;   // "kitti", "pcd", "pcap", "rosbag" (recorded) or "vlp16", "rs16", "vlp32c", "hdl32e" (live UDP packets)
+  std::string path;   // sequence folder, PCD folder, capture file or bag file
   std::vector<std::string> driver_configs;  // live and pcap: YAML with lidar_driver.* keys
   int port = 0;                              // live and pcap: UDP port (0 = the sensor's default)
   std::string channel = "LIDAR_POINTS";
@@ -20,6 +20,8 @@ struct LidarSourceArgs {
   std::string sensor = "vlp16";
   int beams = 0;              // KITTI: the sensor's (0 = detected); PCD: 0 = the profile's
   double period_s = 0.1;      // sweep period when file names are not timestamps
+  // ROS bag only (import): the PointCloud2 topic, and the Imu topic imported alongside (optional).
+  std::string lidar_topic, imu_topic;
 };
 
 // kind_positional: `adit import kitti <dir>` takes the kind as a positional; the bridge uses --source.

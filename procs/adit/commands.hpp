@@ -22,6 +22,7 @@ void registerBenchCommand(CLI::App& app);
 std::string executableDir();
 // A progress bar on stderr (call with 0..1; 1 ends the line).
 void drawProgress(double fraction);
-// Exit status of `adit info` / `adit replay` when the input log was damaged (corrupt frames, truncated):
-// the readable part was used, but the result is not the whole log's.
+// Exit status of `adit info` / `adit replay` when the input log was damaged (corrupt frames, truncated),
+// and of `adit import rosbag` / `adit info` for a bag with lost chunks: the readable part was used, but the
+// result is not the whole input's.
 constexpr int kExitDamagedInput = 3;
