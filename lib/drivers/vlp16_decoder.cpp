@@ -7,7 +7,7 @@
 namespace adit::drivers {
 namespace {
 
-constexpr int kBlocks = 12;
+constexpr int kBlocks = kVelodyneBlocks;
 constexpr std::size_t kBlockBytes = 100;
 // Azimuth advance between blocks above this (10 deg) is not rotation (the head turns < 1 deg per block at
 // 1200 rpm): such a packet straddles a glitch, and its firings keep the block azimuth.
@@ -19,20 +19,18 @@ double forwardGap(std::uint16_t from, std::uint16_t to) {
 
 }  // namespace
 
-Vlp16Decoder::Vlp16Decoder(const std::array<double, kBeams>& elevation_deg, std::vector<std::uint8_t> accept_products)
-    : beams_(BeamTable::fromElevationsDeg(elevation_deg)), accept_products_(std::move(accept_products)) {}
-
-PacketStatus Vlp16Decoder::decode(const std::uint8_t* data, std::size_t size, DecodedPacket& out) const {
+PacketStatus readVelodyneFrame(const std::uint8_t* data, std::size_t size, std::uint8_t product_id,
+                               const std::vector<std::uint8_t>& accept_products,
+                               std::uint16_t (&azimuth)[kVelodyneBlocks], DecodedPacket& out) {
   resetPacket(out, SensorClock::kMicrosPastHour);
   if (data == nullptr || size != kVlp16PacketSize) return PacketStatus::kWrongSize;
   const std::uint8_t mode = data[1204], product = data[1205];
-  if (product != kVlp16ProductId && product != 0 &&
-      std::find(accept_products_.begin(), accept_products_.end(), product) == accept_products_.end())
+  if (product != product_id && product != 0 &&
+      std::find(accept_products.begin(), accept_products.end(), product) == accept_products.end())
     return PacketStatus::kUnknownProduct;
   if (mode != kVlp16Strongest && mode != kVlp16Last && mode != kVlp16Dual && mode != 0)
     return PacketStatus::kUnknownReturnMode;
-  std::uint16_t azimuth[kBlocks];
-  for (int b = 0; b < kBlocks; ++b) {
+  for (int b = 0; b < kVelodyneBlocks; ++b) {
     const std::uint8_t* block = data + b * kBlockBytes;
     if (block[0] != 0xFF || block[1] != 0xEE) return PacketStatus::kBadBlockFlag;
     azimuth[b] = readLe16(block + 2);
@@ -40,6 +38,16 @@ PacketStatus Vlp16Decoder::decode(const std::uint8_t* data, std::size_t size, De
   }
   out.stamp_us = readLe32(data + 1200);
   out.dual_return = mode == kVlp16Dual;
+  return PacketStatus::kOk;
+}
+
+Vlp16Decoder::Vlp16Decoder(const std::array<double, kBeams>& elevation_deg, std::vector<std::uint8_t> accept_products)
+    : beams_(BeamTable::fromElevationsDeg(elevation_deg)), accept_products_(std::move(accept_products)) {}
+
+PacketStatus Vlp16Decoder::decode(const std::uint8_t* data, std::size_t size, DecodedPacket& out) const {
+  std::uint16_t azimuth[kBlocks];
+  const PacketStatus status = readVelodyneFrame(data, size, kVlp16ProductId, accept_products_, azimuth, out);
+  if (status != PacketStatus::kOk) return status;
 
   // Dual return: block pairs (2k: last echo, 2k+1: strongest or second strongest) share their firings.
   const int returns = out.dual_return ? 2 : 1;

@@ -46,4 +46,13 @@ class Vlp16Decoder {
   std::vector<std::uint8_t> accept_products_;
 };
 
+// The packet family's common frame (VLP-16, VLP-32C, HDL-32E: 12 blocks of FF EE, azimuth, 32 points; stamp and
+// factory bytes at the end): checks size, product byte (`product_id`, 0 for old firmware, or one of
+// `accept_products`), return mode, block flags and azimuths, fills `azimuth` (centi-degrees) and sets
+// out.stamp_us and out.dual_return. kOk, or what is wrong.
+constexpr int kVelodyneBlocks = 12;
+PacketStatus readVelodyneFrame(const std::uint8_t* data, std::size_t size, std::uint8_t product_id,
+                               const std::vector<std::uint8_t>& accept_products,
+                               std::uint16_t (&azimuth)[kVelodyneBlocks], DecodedPacket& out);
+
 }  // namespace adit::drivers

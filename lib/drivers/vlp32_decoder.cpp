@@ -10,7 +10,7 @@
 namespace adit::drivers {
 namespace {
 
-constexpr int kBlocks = 12;
+constexpr int kBlocks = kVelodyneBlocks;
 constexpr std::size_t kBlockBytes = 100;
 constexpr double kMaxBlockGapCentiDeg = 1000.0;  // as vlp16_decoder.cpp
 
@@ -84,23 +84,9 @@ Vlp32Decoder::Vlp32Decoder(Velodyne32 model, std::vector<std::uint8_t> accept_pr
 }
 
 PacketStatus Vlp32Decoder::decode(const std::uint8_t* data, std::size_t size, DecodedPacket& out) const {
-  resetPacket(out, SensorClock::kMicrosPastHour);
-  if (data == nullptr || size != kVlp16PacketSize) return PacketStatus::kWrongSize;
-  const std::uint8_t mode = data[1204], product = data[1205];
-  if (product != spec_.product_id && product != 0 &&
-      std::find(accept_products_.begin(), accept_products_.end(), product) == accept_products_.end())
-    return PacketStatus::kUnknownProduct;
-  if (mode != kVlp16Strongest && mode != kVlp16Last && mode != kVlp16Dual && mode != 0)
-    return PacketStatus::kUnknownReturnMode;
   std::uint16_t azimuth[kBlocks];
-  for (int b = 0; b < kBlocks; ++b) {
-    const std::uint8_t* block = data + b * kBlockBytes;
-    if (block[0] != 0xFF || block[1] != 0xEE) return PacketStatus::kBadBlockFlag;
-    azimuth[b] = readLe16(block + 2);
-    if (azimuth[b] >= 36000) return PacketStatus::kBadAzimuth;
-  }
-  out.stamp_us = readLe32(data + 1200);
-  out.dual_return = mode == kVlp16Dual;
+  const PacketStatus status = readVelodyneFrame(data, size, spec_.product_id, accept_products_, azimuth, out);
+  if (status != PacketStatus::kOk) return status;
   const int returns = out.dual_return ? 2 : 1;
   const int groups = kBlocks / returns;
   out.firings.reserve(static_cast<std::size_t>(kBlocks * kBeams32));
