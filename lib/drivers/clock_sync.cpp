@@ -54,17 +54,16 @@ std::int64_t DeviceClockSync::stamp(std::int64_t device_us, std::int64_t host_us
     // Far from the fit: one late sample (ignored) or a new device clock (followed once confirmed).
     far_in_a_row_ = std::abs(observed - far_offset_) <= max_jump_us ? far_in_a_row_ + 1 : 1;
     far_offset_ = observed;
-    if (far_in_a_row_ < config_.jump_confirm) {
-      const auto out = static_cast<std::int64_t>(std::llround(device_us + offsetAt(device_us) - config_.transport_delay_s * 1e6));
-      last_out_ = std::max(out, last_out_ + 1);
-      return last_out_;
-    }
+    if (far_in_a_row_ < config_.jump_confirm) return hostStamp(device_us);
     ++jumps_;
     reset();
   }
   far_in_a_row_ = 0;
   const auto window_us = static_cast<std::int64_t>(config_.window_s * 1e6);
+  // The fit changes only when a window closes, or with the open window's minimum while it is used (refit()).
+  bool fit_changed = false;
   if (!have_current_ || device_us - window_start_ >= window_us || device_us < window_start_) {
+    fit_changed = true;
     if (have_current_) minima_.push_back(current_);
     while (static_cast<int>(minima_.size()) > std::max(config_.windows - 1, 0)) minima_.pop_front();
     current_ = {device_us, observed};
@@ -72,8 +71,13 @@ std::int64_t DeviceClockSync::stamp(std::int64_t device_us, std::int64_t host_us
     have_current_ = true;
   } else if (observed < current_.offset_us) {
     current_ = {device_us, observed};
+    fit_changed = minima_.size() < 2;
   }
-  refit();
+  if (fit_changed) refit();
+  return hostStamp(device_us);
+}
+
+std::int64_t DeviceClockSync::hostStamp(std::int64_t device_us) {
   const auto out = static_cast<std::int64_t>(std::llround(device_us + offsetAt(device_us) - config_.transport_delay_s * 1e6));
   // A refit may move the line by microseconds; stamps must still advance.
   last_out_ = last_out_ == INT64_MIN ? out : std::max(out, last_out_ + 1);

@@ -42,6 +42,8 @@ class DeviceClockSync {
   };
   void refit();
   void reset();
+  // The fit's host time of device_us, minus the transport delay, never before the previous stamp.
+  std::int64_t hostStamp(std::int64_t device_us);
 
   ClockSyncConfig config_;
   std::deque<Minimum> minima_;  // closed windows, oldest first
