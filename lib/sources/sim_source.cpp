@@ -51,7 +51,7 @@ bool SimSource::next(runtime::OutgoingMessage& out) {
     if (!scan) ++imu_seq_;
   }
   if (event.kind == sim::SimEvent::Kind::Scan) {
-    if (observer_) observer_(event.scan);
+    for (const auto& observe : sweep_observers_) observe(event.scan);
     out = {channels_.lidar,
            channels_.compact_sweeps ? msg::encode(msg::encodeSweep(event.scan, &firing_table_))
                                     : msg::encode(msg::toMessage(event.scan)),
@@ -67,6 +67,7 @@ bool SimSource::next(runtime::OutgoingMessage& out) {
       pending_truth_ = runtime::OutgoingMessage{channels_.ground_truth, msg::encode(t), truth.utime};
     }
   } else {
+    for (const auto& observe : imu_observers_) observe(event.imu);
     adit::imu_t m = msg::toMessage(event.imu);
     m.header.seq = imu_seq_++;
     out = {channels_.imu, msg::encode(m), event.imu.utime};

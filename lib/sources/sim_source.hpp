@@ -9,6 +9,7 @@
 
 #include <functional>
 #include <memory>
+#include <vector>
 
 namespace adit::sources {
 
@@ -42,8 +43,10 @@ class SimSource : public runtime::MessageSource {
   double progress() const override;
 
   const sim::Simulator& simulator() const { return simulator_; }
-  // Called with every sweep as it is published (e.g. to also write it as sensor packets, `--pcap`).
-  void setSweepObserver(std::function<void(const LidarScan&)> observer) { observer_ = std::move(observer); }
+  // Each observer is called with every sweep / IMU sample as it is published, in the order added (e.g. to
+  // also write the run as sensor packets, `--pcap`, or as a bag, `--bag`).
+  void addSweepObserver(std::function<void(const LidarScan&)> observer) { sweep_observers_.push_back(std::move(observer)); }
+  void addImuObserver(std::function<void(const ImuSample&)> observer) { imu_observers_.push_back(std::move(observer)); }
   // T_world_lidar at each sweep's utime (its last firing), in the order published (stalled sweeps left out).
   const Trajectory& groundTruth() const { return truth_; }
 
@@ -58,7 +61,8 @@ class SimSource : public runtime::MessageSource {
   Trajectory truth_;
   std::optional<runtime::OutgoingMessage> pending_truth_;  // published right after its sweep
   std::int64_t imu_seq_ = 0, truth_seq_ = 0;
-  std::function<void(const LidarScan&)> observer_;
+  std::vector<std::function<void(const LidarScan&)>> sweep_observers_;
+  std::vector<std::function<void(const ImuSample&)>> imu_observers_;
 };
 
 }  // namespace adit::sources

@@ -5,6 +5,7 @@
 #include "io/pcd.hpp"
 #include "runtime/process.hpp"
 #include "io/atomic_file.hpp"
+#include "sources/sim_bag.hpp"
 #include "sources/sim_pcap.hpp"
 #include "sources/sim_source.hpp"
 
@@ -15,7 +16,7 @@ namespace {
 
 struct SimArgs {
   std::vector<std::string> configs;
-  std::string world, sensor, output, gt, world_pcd, lcm_url, pcap;
+  std::string world, sensor, output, gt, world_pcd, lcm_url, pcap, bag, bag_compression = "none";
   double duration_s = -1, rate = 1.0, world_spacing = 0.1, start_speed = -1;
   std::int64_t seed = -1;
   bool live = false, no_truth_channel = false, no_imu = false;
@@ -42,6 +43,29 @@ adit::sources::SimStall parseStall(const std::string& text, const std::string& f
   return stall;
 }
 
+// A file written beside the run (--pcap, --bag): `attach` hooks its recorder to the source and returns what
+// completes the file once the run has ended; `done` reports it.
+struct Recording {
+  std::string path;
+  std::function<std::function<void()>(adit::sources::SimSource&, std::ostream&)> attach;
+  std::function<void()> done;
+};
+
+// Runs the source with every recording open, each written atomically: a failed run leaves none of them.
+void runRecording(adit::sources::SimSource& source, const adit::runtime::SourceRunOptions& run,
+                  const std::vector<Recording>& files, std::size_t i = 0) {
+  if (i == files.size()) {
+    if (const int code = adit::runtime::runSource(source, run); code != 0) throw CLI::RuntimeError(code);
+    return;
+  }
+  adit::io::writeFileAtomically(files[i].path, [&](std::ostream& out) {
+    const std::function<void()> complete = files[i].attach(source, out);
+    runRecording(source, run, files, i + 1);
+    complete();
+  });
+  files[i].done();
+}
+
 }  // namespace
 
 void registerSimCommand(CLI::App& app) {
@@ -58,6 +82,10 @@ void registerSimCommand(CLI::App& app) {
   cmd->add_option("--world-pcd", a->world_pcd, "Also write the world's surfaces as a PCD (for comparing with the map)");
   cmd->add_option("--pcap", a->pcap, "Also write the lidar as the VLP-16 packet capture a real sensor would give "
                  "(classic pcap; --sensor vlp16 only)");
+  cmd->add_option("--bag", a->bag, "Also write the run as a ROS 1 bag: /velodyne_points (sensor_msgs/PointCloud2 in the "
+                 "ROS Velodyne driver's layout) and /imu/data (sensor_msgs/Imu)");
+  cmd->add_option("--bag-compression", a->bag_compression, "Chunk compression of --bag: none (as rosbag record), bz2, lz4")
+      ->check(CLI::IsMember({"none", "bz2", "lz4"}));
   cmd->add_option("--world-spacing", a->world_spacing, "Point spacing of --world-pcd (m)")->check(CLI::PositiveNumber);
   cmd->add_flag("--live", a->live, "Publish over LCM in real time instead of writing a log");
   cmd->add_option("--rate", a->rate, "With --live: multiple of real time (0 = as fast as possible)")->check(CLI::NonNegativeNumber);
@@ -101,19 +129,33 @@ void registerSimCommand(CLI::App& app) {
     run.output_log = a->output;
     run.lcm_url = a->lcm_url;
     run.rate = a->rate;
-    if (a->pcap.empty()) {
-      if (const int code = adit::runtime::runSource(source, run); code != 0) throw CLI::RuntimeError(code);
-    } else {
-      // The capture is written alongside, atomically: a failed run leaves no file.
-      std::int64_t packets = 0;
-      adit::io::writeFileAtomically(a->pcap, [&](std::ostream& out) {
-        adit::sources::SimPcapRecorder recorder(source.simulator().lidar(), out);
-        source.setSweepObserver([&recorder](const adit::LidarScan& scan) { recorder.addSweep(scan); });
-        if (const int code = adit::runtime::runSource(source, run); code != 0) throw CLI::RuntimeError(code);
-        packets = recorder.packets();
-      });
-      fmt::print("sim: wrote {} VLP-16 packets to {}\n", packets, a->pcap);
+    std::vector<Recording> files;
+    if (!a->pcap.empty()) {
+      auto packets = std::make_shared<std::int64_t>(0);
+      files.push_back({a->pcap,
+                       [packets](adit::sources::SimSource& sim, std::ostream& out) -> std::function<void()> {
+                         auto recorder = std::make_shared<adit::sources::SimPcapRecorder>(sim.simulator().lidar(), out);
+                         sim.addSweepObserver([recorder](const adit::LidarScan& scan) { recorder->addSweep(scan); });
+                         return [recorder, packets] { *packets = recorder->packets(); };
+                       },
+                       [packets, path = a->pcap] { fmt::print("sim: wrote {} VLP-16 packets to {}\n", *packets, path); }});
     }
+    if (!a->bag.empty()) {
+      auto messages = std::make_shared<std::int64_t>(0);
+      files.push_back({a->bag,
+                       [messages, compression = a->bag_compression](adit::sources::SimSource& sim,
+                                                                    std::ostream& out) -> std::function<void()> {
+                         auto recorder = std::make_shared<adit::sources::SimBagRecorder>(out, compression);
+                         sim.addSweepObserver([recorder](const adit::LidarScan& scan) { recorder->addSweep(scan); });
+                         sim.addImuObserver([recorder](const adit::ImuSample& s) { recorder->addImu(s); });
+                         return [recorder, messages] {
+                           recorder->finish();
+                           *messages = recorder->messages();
+                         };
+                       },
+                       [messages, path = a->bag] { fmt::print("sim: wrote {} bag messages to {}\n", *messages, path); }});
+    }
+    runRecording(source, run, files);
     if (!a->gt.empty()) {
       adit::eval::writeTum(a->gt, source.groundTruth());
       fmt::print("sim: wrote ground truth ({} poses) to {}\n", source.groundTruth().size(), a->gt);

@@ -1,13 +1,16 @@
-// Test helper: writes ROS 1 bag format 2.0 files from scratch (none / bz2 / lz4 chunks, connection and
-// message records, trailing connection copies and the bag header's index_pos), and serialises the two
-// message types adit reads, so tests know exactly what a bag holds. Also used for the fuzz seeds.
+// Test helper: bags written in memory through the library's writer (io/rosbag_writer.hpp), so tests know
+// exactly what a bag holds and where its chunks lie (to damage them). Also used for the fuzz seeds.
 #pragma once
 
 #include <cstdint>
+#include <memory>
+#include <sstream>
 #include <string>
 #include <vector>
 
 #include "core/types.hpp"
+#include "io/ros_encode.hpp"
+#include "io/rosbag_writer.hpp"
 
 namespace adit::test {
 
@@ -15,42 +18,27 @@ using Bytes = std::vector<std::uint8_t>;
 
 class BagWriter {
  public:
-  // compression: "none", "bz2" or "lz4" (LZ4 frame format, as roslz4 writes it).
+  // compression: "none", "bz2", "lz4", or any other four-letter name (e.g. "zstd"): the chunks are then stored
+  // uncompressed under that name, a bag whose chunks the reader cannot decompress.
   // header_padding: rosbag pads the bag header record to 4096 bytes; the fuzz seeds use 0 to stay small.
-  explicit BagWriter(std::string compression, std::size_t header_padding = 4096)
-      : compression_(std::move(compression)), padding_(header_padding) {}
+  explicit BagWriter(const std::string& compression, std::size_t header_padding = 4096);
+  // `type`: sensor_msgs/PointCloud2 and sensor_msgs/Imu get their real md5sums and definitions.
   void addConnection(std::uint32_t id, const std::string& topic, const std::string& type);
-  // Appends to the open chunk; the connection's record goes into the chunk before its first message.
-  void addMessage(std::uint32_t conn, std::int64_t time_ns, const Bytes& data);
+  void addMessage(std::uint32_t conn, std::int64_t time_ns, const Bytes& data) { writer_->write(conn, time_ns, data); }
   // Closes the open chunk (no-op if empty). Returns the byte range [begin, end) of the chunk's data.
-  std::pair<std::size_t, std::size_t> endChunk();
-  // The whole file: version line, bag header, chunks, trailing connections and chunk infos (the index).
+  std::pair<std::size_t, std::size_t> endChunk() { return writer_->endChunk(); }
+  // The whole file.
   std::string finish();
-  // File offset of each chunk record (valid after finish()).
-  const std::vector<std::uint64_t>& chunkPositions() const { return chunk_pos_; }
+  // File offset of each chunk record.
+  const std::vector<std::uint64_t>& chunkPositions() const { return writer_->chunkPositions(); }
 
  private:
-  struct Conn {
-    std::uint32_t id;
-    std::string topic, type;
-  };
-  std::string connectionRecord(const Conn& c) const;
-  std::string bagHeaderRecord(std::uint64_t index_pos) const;
-  std::string compression_;
-  std::size_t padding_;
-  std::vector<Conn> conns_;
-  std::vector<bool> in_chunk_;
-  std::string chunk_, body_;
-  int chunks_ = 0;
-  std::vector<std::uint64_t> chunk_pos_;
+  std::string unknown_compression_;
+  std::ostringstream out_;
+  std::unique_ptr<io::RosbagWriter> writer_;
 };
 
-// One field of a PointCloud2 (datatype: 1 INT8 .. 8 FLOAT64, as sensor_msgs/PointField).
-struct CloudField {
-  std::string name;
-  std::uint32_t offset;
-  std::uint8_t datatype;
-};
+using CloudField = io::RosPointField;
 
 // sensor_msgs/PointCloud2 with height 1 (or `height` rows, each padded by `row_padding` bytes).
 Bytes pointCloud2(std::uint32_t sec, std::uint32_t nsec, const std::vector<CloudField>& fields, std::uint32_t point_step,

@@ -1,11 +1,17 @@
-// A simulated VLP-16 run written as the packet capture a real sensor would give (`adit sim --pcap`), read back
-// by the pcap source (`adit import pcap` / adit-lidar-bridge --source pcap) and run through the whole pipeline
-// with the run's IMU: the same accuracy as the simulator's own log (APE within 5 %).
+// A simulated VLP-16 run written as the recordings a real robot gives and read back through adit's readers:
+//  - the packet capture of the sensor (`adit sim --pcap`), through the pcap source (`adit import pcap` /
+//    adit-lidar-bridge --source pcap), with the run's IMU;
+//  - a ROS 1 bag of the ROS drivers' PointCloud2 and Imu messages (`adit sim --bag`), through the bag source
+//    (`adit import rosbag`), lidar and IMU both from the bag;
+// each run through the whole pipeline: the same accuracy as the simulator's own log (APE within 5 %).
+// Two ctests (pcap_replay, bag_replay) over this one file, each selecting its test.
 #include "eval/evaluate.hpp"
 #include "eval/trajectory_io.hpp"
 #include "pipeline/replay.hpp"
 #include "runtime/process.hpp"
 #include "sources/pcap_source.hpp"
+#include "sources/rosbag_source.hpp"
+#include "sources/sim_bag.hpp"
 #include "sources/sim_pcap.hpp"
 #include "sources/sim_source.hpp"
 
@@ -51,7 +57,7 @@ ReplayRun replay(std::vector<runtime::OutgoingMessage> messages, const Trajector
   VectorSource source(std::move(messages));
   pipeline::ReplayOptions options;
   options.source = &source;
-  options.out_dir = (fs::temp_directory_path() / ("adit_pcap_replay_" + tag + "_" + std::to_string(::getpid()))).string();
+  options.out_dir = (fs::temp_directory_path() / ("adit_recording_replay_" + tag + "_" + std::to_string(::getpid()))).string();
   options.config = pipelineConfig();
   options.record = "";
   const pipeline::ReplayReport report = pipeline::runReplay(options);
@@ -77,7 +83,7 @@ TEST(PcapReplay, SameAccuracyAsTheSimulatorsLog) {
   {
     std::ofstream out(pcap, std::ios::binary);
     sources::SimPcapRecorder recorder(source.simulator().lidar(), out);
-    source.setSweepObserver([&recorder](const LidarScan& scan) { recorder.addSweep(scan); });
+    source.addSweepObserver([&recorder](const LidarScan& scan) { recorder.addSweep(scan); });
     runtime::OutgoingMessage m;
     while (source.next(m)) logged.push_back(m);
     packets = recorder.packets();
@@ -113,6 +119,64 @@ TEST(PcapReplay, SameAccuracyAsTheSimulatorsLog) {
   // The capture's 2 mm range steps and per-firing times give the pipeline slightly different points: the
   // APE stays within 5 % of the log's either way (measured -4.9 %).
   EXPECT_LE(std::abs(pcap_run.ape_rmse_m - log_run.ape_rmse_m), 0.05 * log_run.ape_rmse_m);
+}
+
+}  // namespace
+}  // namespace adit
+
+namespace adit {
+namespace {
+
+TEST(BagReplay, SameAccuracyAsTheSimulatorsLog) {
+  sim::SimConfig sim = sim::simConfigFrom(pipelineConfig());
+  sim.world = "roadway-loop";
+  sim.sensor = "vlp16";
+  sim.duration_s = 20.0;
+  sim.seed = 4;
+  sources::SimSource source(sim, sources::SimChannels{});
+  const std::string bag = (fs::temp_directory_path() / ("adit_bag_replay_" + std::to_string(::getpid()) + ".bag")).string();
+  std::vector<runtime::OutgoingMessage> logged;
+  std::int64_t bag_messages = 0;
+  {
+    std::ofstream out(bag, std::ios::binary);
+    sources::SimBagRecorder recorder(out, "lz4");
+    source.addSweepObserver([&recorder](const LidarScan& scan) { recorder.addSweep(scan); });
+    source.addImuObserver([&recorder](const ImuSample& s) { recorder.addImu(s); });
+    runtime::OutgoingMessage m;
+    while (source.next(m)) logged.push_back(m);
+    recorder.finish();
+    bag_messages = recorder.messages();
+  }
+  const auto bag_bytes = fs::file_size(bag);
+  // Everything from the bag: its PointCloud2 sweeps and Imu samples, as `adit import rosbag` reads them.
+  sources::RosbagSourceConfig config;
+  config.lidar_topic = "/velodyne_points";
+  config.imu_topic = "/imu/data";
+  config.cloud.sensor = "vlp16";
+  auto reader = sources::makeRosbagSource(bag, config);
+  std::vector<runtime::OutgoingMessage> from_bag;
+  runtime::OutgoingMessage m;
+  while (reader->next(m)) from_bag.push_back(m);
+  const runtime::Health health = reader->health();
+  fs::remove(bag);
+  const auto count = [](const std::vector<runtime::OutgoingMessage>& messages, const std::string& channel) {
+    return std::count_if(messages.begin(), messages.end(), [&](const auto& m) { return m.channel == channel; });
+  };
+  EXPECT_EQ(health.errors, 0);
+  EXPECT_EQ(count(from_bag, "LIDAR_POINTS"), count(logged, "LIDAR_POINTS"));
+  EXPECT_EQ(count(from_bag, "IMU"), count(logged, "IMU"));
+  EXPECT_EQ(static_cast<std::int64_t>(from_bag.size()), bag_messages);
+
+  const ReplayRun log_run = replay(logged, source.groundTruth(), "log");
+  const ReplayRun bag_run = replay(from_bag, source.groundTruth(), "bag");
+  std::printf("bag: %lld messages, %.1f MB (lz4); sweeps: log %lld, bag %lld; APE rmse: log %.4f m, bag %.4f m (%+.1f %%)\n",
+              static_cast<long long>(bag_messages), static_cast<double>(bag_bytes) / 1e6,
+              static_cast<long long>(log_run.sweeps), static_cast<long long>(bag_run.sweeps), log_run.ape_rmse_m,
+              bag_run.ape_rmse_m, 100.0 * (bag_run.ape_rmse_m / log_run.ape_rmse_m - 1.0));
+  EXPECT_EQ(bag_run.sweeps, log_run.sweeps);
+  // The bag holds the points as float32 where the log's compact sweeps hold them in mm steps: the APE stays
+  // within 5 % of the log's either way.
+  EXPECT_LE(std::abs(bag_run.ape_rmse_m - log_run.ape_rmse_m), 0.05 * log_run.ape_rmse_m);
 }
 
 }  // namespace
