@@ -13,6 +13,7 @@
 #include <chrono>
 #include <cmath>
 #include <deque>
+#include <optional>
 #include <stdexcept>
 
 namespace adit::drivers {
@@ -26,6 +27,7 @@ class UdpLidarSource : public runtime::MessageSource {
         channel_(config.channel),
         idle_timeout_(std::chrono::duration<double>(config.idle_timeout_s)),
         stop_(std::move(stop)) {
+    openDeviceInfoPort(config);
     spdlog::info("{} listening on {}:{} (receive buffer {} bytes{})", config.model, config.bind_address,
                  socket_.port(), socket_.receiveBufferBytes(),
                  socket_.receiveBufferBytes() < config.recv_buffer_bytes
@@ -44,11 +46,13 @@ class UdpLidarSource : public runtime::MessageSource {
       switch (socket_.receive(payload_, size, receive_ns, 100, error)) {
         case UdpReceiver::Result::kPacket:
           last_packet = Clock::now();
+          if (packets_++ % 256 == 0) readDeviceInfo();  // before the first packet, then every ~0.3 s
           stream_.push(payload_.data(), size, receive_ns, sweeps_);
           for (LidarScan& s : sweeps_) ready_.push_back(std::move(s));
           sweeps_.clear();
           break;
         case UdpReceiver::Result::kTimeout:
+          readDeviceInfo();
           if (idle_timeout_.count() > 0 && Clock::now() - last_packet > idle_timeout_) {
             spdlog::info("no lidar packet for {} s: stopping", idle_timeout_.count());
             return false;
@@ -82,8 +86,34 @@ class UdpLidarSource : public runtime::MessageSource {
   }
 
  private:
+  // RS-16: the sensor sends its DIFOP packet (return mode, calibrated vertical angles) once a second to its
+  // own port. A port someone else holds costs only the calibration: the nominal table is used, with a warning.
+  void openDeviceInfoPort(const UdpLidarConfig& config) {
+    if (config.model != "rs16" || config.difop_port < 0) return;
+    const auto port = static_cast<std::uint16_t>(config.difop_port > 0 ? config.difop_port : kRs16DifopPort);
+    try {
+      device_info_.emplace(config.bind_address, port, 64 * 1024);
+      spdlog::info("rs16 DIFOP listening on {}:{}", config.bind_address, port);
+    } catch (const std::runtime_error& e) {
+      spdlog::warn("no RS-16 DIFOP: {}; return mode and vertical angles stay as configured", e.what());
+    }
+  }
+  // Hands every DIFOP datagram waiting to the stream (it comes 1 Hz; read before the first data packet,
+  // every 256 packets and when idle, so a socket read per packet is not spent on it).
+  void readDeviceInfo() {
+    if (!device_info_) return;
+    std::size_t size = 0;
+    std::int64_t receive_ns = 0;
+    std::string error;
+    while (device_info_->receive(difop_payload_, size, receive_ns, 0, error) == UdpReceiver::Result::kPacket)
+      stream_.pushDeviceInfo(difop_payload_.data(), std::min(size, difop_payload_.size()));
+  }
+
   LidarPacketStream stream_;
   UdpReceiver socket_;
+  std::optional<UdpReceiver> device_info_;
+  std::vector<std::uint8_t> difop_payload_;
+  std::int64_t packets_ = 0;
   std::string channel_;
   std::chrono::duration<double> idle_timeout_;
   std::function<bool()> stop_;
@@ -138,6 +168,9 @@ std::uint16_t dataPortOf(const UdpLidarConfig& config) {
 LidarStreamConfig streamConfigOf(const UdpLidarConfig& config) {
   LidarStreamConfig s;
   s.model = modelOf(config.model);
+  if (config.difop_port < -1 || config.difop_port > 65535)
+    throw std::invalid_argument("lidar driver: difop_port " + std::to_string(config.difop_port) +
+                                " is not a UDP port (0 = 7788, -1 = none)");
   s.elevations_deg = config.vertical_angles_deg;
   if (!s.elevations_deg.empty() && s.elevations_deg.size() != kBeams)
     throw std::invalid_argument("lidar driver: vertical_angles_deg needs 16 values, got " +

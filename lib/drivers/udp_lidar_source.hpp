@@ -52,7 +52,8 @@ struct UdpLidarConfig {
   // lidar_driver.dual_return: RS-16 only: decode dual-return packets from the start (a DIFOP packet, if the
   // recording or the network holds one, says which mode the sensor is in and overrides this).
   bool dual_return = false;
-  // lidar_driver.difop_port: RS-16 only: the port of the DIFOP packets (recordings; 0 = 7788).
+  // lidar_driver.difop_port: RS-16 only: the port of the DIFOP packets, live and in recordings (0 = 7788,
+  // -1 = ignore them). Live, a port another program holds is a warning: the configured table is used.
   int difop_port = 0;
   // lidar_driver.sensor_address: recordings (pcap): only datagrams from this IPv4 address are the sensor's;
   // "" = the first host that sends a packet of the model's size to the data port.

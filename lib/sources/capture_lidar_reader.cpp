@@ -26,11 +26,8 @@ drivers::LidarStreamConfig streamConfig(const drivers::UdpLidarConfig& config) {
 
 CaptureLidarReader::CaptureLidarReader(std::istream& in, std::string name, const drivers::UdpLidarConfig& config)
     : name_(std::move(name)), model_(drivers::streamConfigOf(config).model), reader_(in, name_), stream_(streamConfig(config)), port_(drivers::dataPortOf(config)) {
-  if (config.model == "rs16") {
-    if (config.difop_port < 0 || config.difop_port > 65535)
-      throw std::invalid_argument("lidar driver: difop_port " + std::to_string(config.difop_port) + " is not a UDP port");
+  if (config.model == "rs16" && config.difop_port >= 0)  // range checked by streamConfigOf
     difop_port_ = config.difop_port > 0 ? config.difop_port : drivers::kRs16DifopPort;
-  }
   if (!config.sensor_address.empty()) {
     if (!io::parseIpv4(config.sensor_address, sensor_ip_))
       throw std::invalid_argument("lidar driver: sensor_address '" + config.sensor_address + "' is not an IPv4 address");

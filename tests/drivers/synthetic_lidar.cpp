@@ -1,5 +1,6 @@
 #include "synthetic_lidar.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 namespace adit::drivers::testing {
@@ -124,6 +125,28 @@ std::vector<std::uint8_t> SyntheticLidar::packet(int k, std::vector<TruthFiring>
     bytes[1247] = 0xFF;
   }
   return bytes;
+}
+
+std::vector<std::uint8_t> rs16DifopPacket(bool dual, const std::array<double, 16>& elevation_deg) {
+  std::vector<std::uint8_t> p(1248, 0);
+  const std::uint8_t magic[8] = {0xA5, 0xFF, 0x00, 0x5A, 0x11, 0x11, 0x55, 0x55};
+  std::copy(magic, magic + 8, p.begin());
+  p[300] = dual ? 0 : 1;
+  for (std::size_t i = 0; i < 16; ++i) {
+    const auto v = static_cast<std::uint32_t>(std::lround(std::abs(elevation_deg[i]) * 1000.0));
+    p[1165 + 3 * i] = static_cast<std::uint8_t>(v >> 16);
+    p[1166 + 3 * i] = static_cast<std::uint8_t>(v >> 8);
+    p[1167 + 3 * i] = static_cast<std::uint8_t>(v);
+  }
+  p[1246] = 0x0F;
+  p[1247] = 0xF0;
+  return p;
+}
+
+std::array<double, 16> nominalRs16Elevations() {
+  std::array<double, 16> e{};
+  for (int i = 0; i < 16; ++i) e[static_cast<std::size_t>(i)] = elevationDeg(Model::kRs16, i);
+  return e;
 }
 
 }  // namespace adit::drivers::testing

@@ -5,6 +5,7 @@
 
 #include <Eigen/Core>
 
+#include <array>
 #include <cstdint>
 #include <vector>
 
@@ -46,6 +47,12 @@ struct SyntheticLidar {
 // Nominal elevation (deg) and ring of a laser id, from the manuals' tables.
 double elevationDeg(Model model, int laser);
 int ringOf(Model model, int laser);
+
+// An RS-16 DIFOP packet: return mode byte 300 (0 dual, 1 strongest), vertical angles at 1165 (3 bytes each,
+// 0.001 deg, channels 0..7 negative), per the RS-LiDAR-16 user guide.
+std::vector<std::uint8_t> rs16DifopPacket(bool dual, const std::array<double, 16>& elevation_deg);
+// The RS-16's nominal elevations by laser id.
+std::array<double, 16> nominalRs16Elevations();
 
 // Fixed RS-16 packet date: 2024-03-15 10:20:30.000000 UTC.
 constexpr std::int64_t kRs16TestEpochUs = 1710498030LL * 1000000;

@@ -42,30 +42,6 @@ struct Recording {
   std::function<void(std::vector<std::uint8_t>&)> mutate;  // rewrites every data packet
 };
 
-// An RS-16 DIFOP packet: return mode byte 300 (0 dual, 1 strongest), vertical angles at 1165 (3 bytes each,
-// 0.001 deg, channels 0..7 negative), per the RS-LiDAR-16 user guide.
-std::vector<std::uint8_t> difopPacket(bool dual, const std::array<double, 16>& elevation_deg) {
-  std::vector<std::uint8_t> p(1248, 0);
-  const std::uint8_t magic[8] = {0xA5, 0xFF, 0x00, 0x5A, 0x11, 0x11, 0x55, 0x55};
-  std::copy(magic, magic + 8, p.begin());
-  p[300] = dual ? 0 : 1;
-  for (std::size_t i = 0; i < 16; ++i) {
-    const auto v = static_cast<std::uint32_t>(std::lround(std::abs(elevation_deg[i]) * 1000.0));
-    p[1165 + 3 * i] = static_cast<std::uint8_t>(v >> 16);
-    p[1166 + 3 * i] = static_cast<std::uint8_t>(v >> 8);
-    p[1167 + 3 * i] = static_cast<std::uint8_t>(v);
-  }
-  p[1246] = 0x0F;
-  p[1247] = 0xF0;
-  return p;
-}
-
-std::array<double, 16> nominalRs16() {
-  std::array<double, 16> e{};
-  for (int i = 0; i < 16; ++i) e[static_cast<std::size_t>(i)] = drivers::testing::elevationDeg(Model::kRs16, i);
-  return e;
-}
-
 std::int64_t captureNs(const SyntheticLidar& lidar, int k) {
   return kHost0Ns + k * lidar.packetNs() + lidar.lastFiringNs() + kLatencyNs;
 }
@@ -200,7 +176,7 @@ TEST_P(PcapRecording, DecodesToTheKnownFiringsDespiteLossReorderAndFragments) {
   r.reordered = 100;
   r.fragmented = 150;
   // An RS-16 says its return mode only in DIFOP packets: the recording holds one (nominal angles).
-  if (lidar.model == Model::kRs16) r.difop = difopPacket(lidar.dual, nominalRs16());
+  if (lidar.model == Model::kRs16) r.difop = drivers::testing::rs16DifopPacket(lidar.dual, drivers::testing::nominalRs16Elevations());
   const Decoded d = decode(writeRecording(lidar, r), configOf(lidar));
   // The first revolution began mid-way (dropped), three complete ones, the last one partial.
   ASSERT_EQ(d.sweeps.size(), 4u);
@@ -228,9 +204,9 @@ TEST(PcapRecording, Rs16DifopCalibratedAnglesReplaceTheNominalOnes) {
   lidar.stamp0_us = drivers::testing::kRs16TestEpochUs;
   Recording r;
   r.packets = 200;
-  std::array<double, 16> calibrated = nominalRs16();
+  std::array<double, 16> calibrated = drivers::testing::nominalRs16Elevations();
   for (std::size_t i = 0; i < 16; ++i) calibrated[i] += (i < 8 ? -0.137 : 0.211);
-  r.difop = difopPacket(false, calibrated);
+  r.difop = drivers::testing::rs16DifopPacket(false, calibrated);
   const Decoded d = decode(writeRecording(lidar, r), configOf(lidar));
   EXPECT_EQ(d.health.counters.at("difop"), 1);
   EXPECT_EQ(d.health.counters.at("difop_applied"), 1);
@@ -245,7 +221,7 @@ TEST(PcapRecording, Rs16DifopCalibratedAnglesReplaceTheNominalOnes) {
   EXPECT_GT(checked, 10000u);
   // A configured table is the user's calibration: it wins over the sensor's.
   drivers::UdpLidarConfig config = configOf(lidar);
-  const std::array<double, 16> nominal = nominalRs16();
+  const std::array<double, 16> nominal = drivers::testing::nominalRs16Elevations();
   config.vertical_angles_deg.assign(nominal.begin(), nominal.end());
   const Decoded mine = decode(writeRecording(lidar, r), config);
   EXPECT_EQ(mine.health.counters.count("difop_applied"), 0u);

@@ -14,7 +14,9 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <atomic>
+#include <cmath>
 #include <chrono>
 #include <random>
 #include <thread>
@@ -43,6 +45,21 @@ void sendPackets(const std::vector<std::vector<std::uint8_t>>& packets, std::uin
   close(fd);
 }
 
+// Binds the source on random high ports (another program may hold one, so try a few); RS-16: the DIFOP
+// port too.
+std::unique_ptr<runtime::MessageSource> bindOnRandomPorts(UdpLidarConfig& config) {
+  std::mt19937 rng(std::random_device{}());
+  for (int attempt = 0; attempt < 20; ++attempt) {
+    config.port = 20000 + static_cast<int>(rng() % 40000);
+    if (config.model == "rs16") config.difop_port = 20000 + static_cast<int>(rng() % 40000);
+    try {
+      return makeUdpLidarSource(config, [] { return false; });
+    } catch (const std::runtime_error&) {
+    }
+  }
+  return nullptr;
+}
+
 TEST(UdpLidarSource, SweepsFromRealUdpPackets) {
   SyntheticLidar lidar;
   lidar.stamp0_us = 3599000000LL;  // crosses the sensor's hour wrap on the way
@@ -63,16 +80,7 @@ TEST(UdpLidarSource, SweepsFromRealUdpPackets) {
   }
   ASSERT_EQ(expected.size(), 3u);
 
-  // A random high port; another program may hold it, so try a few.
-  std::mt19937 rng(std::random_device{}());
-  std::unique_ptr<runtime::MessageSource> source;
-  for (int attempt = 0; attempt < 20 && !source; ++attempt) {
-    config.port = 20000 + static_cast<int>(rng() % 40000);
-    try {
-      source = makeUdpLidarSource(config, [] { return false; });
-    } catch (const std::runtime_error&) {
-    }
-  }
+  std::unique_ptr<runtime::MessageSource> source = bindOnRandomPorts(config);
   ASSERT_TRUE(source) << "no free UDP port";
 
   std::thread sender(sendPackets, std::cref(packets), static_cast<std::uint16_t>(config.port),
@@ -125,6 +133,55 @@ TEST(UdpLidarSource, SweepsFromRealUdpPackets) {
   std::cout << n << " packets over UDP -> " << messages.size() << " sweeps in " << seconds << " s\n";
 }
 
+// A live RS-16 sends its calibration (DIFOP) to its own port once a second: the bridge listens there too, and
+// the calibrated vertical angles replace the nominal ones from the first sweep on.
+TEST(UdpLidarSource, Rs16DifopOnItsOwnPortCalibratesLiveSweeps) {
+  SyntheticLidar lidar;
+  lidar.model = testing::Model::kRs16;
+  lidar.stamp0_us = testing::kRs16TestEpochUs;
+  const int n = static_cast<int>(3.6 * lidar.rotationNs() / static_cast<double>(lidar.packetNs()));
+  std::vector<std::vector<std::uint8_t>> packets;
+  for (int k = 0; k < n; ++k) packets.push_back(lidar.packet(k));
+  std::array<double, 16> calibrated = testing::nominalRs16Elevations();
+  for (std::size_t i = 0; i < 16; ++i) calibrated[i] += (i < 8 ? -0.137 : 0.211);
+
+  UdpLidarConfig config;
+  config.model = "rs16";
+  config.idle_timeout_s = 0.5;
+  config.bind_address = "127.0.0.1";
+  std::unique_ptr<runtime::MessageSource> source = bindOnRandomPorts(config);
+  ASSERT_TRUE(source) << "no free UDP port";
+  sendPackets({testing::rs16DifopPacket(false, calibrated)}, static_cast<std::uint16_t>(config.difop_port),
+              std::chrono::microseconds(0));
+  std::this_thread::sleep_for(std::chrono::milliseconds(20));  // the DIFOP is waiting before the data comes
+  std::thread sender(sendPackets, std::cref(packets), static_cast<std::uint16_t>(config.port),
+                     std::chrono::microseconds(500));
+  std::vector<LidarScan> sweeps;
+  runtime::OutgoingMessage m;
+  while (source->next(m)) {
+    adit::lidar_scan_t msg;
+    ASSERT_GE(msg.decode(m.data.data(), 0, static_cast<int>(m.data.size())), 0);
+    sweeps.emplace_back();
+    ASSERT_EQ(msg::decodeSweep(msg, sweeps.back()), "");
+  }
+  sender.join();
+
+  const runtime::Health& h = source->health();
+  EXPECT_EQ(h.counters.at("difop"), 1);
+  EXPECT_EQ(h.counters.at("difop_applied"), 1);
+  ASSERT_EQ(sweeps.size(), 3u);
+  std::size_t checked = 0;
+  for (const LidarScan& sweep : sweeps)
+    for (const LidarPoint& p : sweep.points) {
+      // RS-16 rings 0..7 are lasers 0..7, rings 8..15 lasers 15..8. The offsets are 0.14-0.21 deg; the
+      // compact sweep keeps directions to a few thousandths of a degree.
+      const std::size_t laser = p.ring < 8 ? p.ring : 23u - p.ring;
+      EXPECT_NEAR(std::asin(p.p.z() / p.p.norm()) * 180.0 / M_PI, calibrated[laser], 0.02);
+      ++checked;
+    }
+  EXPECT_GT(checked, 20000u);
+}
+
 TEST(UdpLidarSource, BadConfigIsRefusedUpFront) {
   UdpLidarConfig c;
   c.model = "hdl64";
@@ -134,6 +191,10 @@ TEST(UdpLidarSource, BadConfigIsRefusedUpFront) {
   EXPECT_THROW(makeUdpLidarSource(c), std::invalid_argument);
   c = UdpLidarConfig{};
   c.vertical_angles_deg = {1, 2, 3};
+  EXPECT_THROW(makeUdpLidarSource(c), std::invalid_argument);
+  c = UdpLidarConfig{};
+  c.model = "rs16";
+  c.difop_port = 70000;
   EXPECT_THROW(makeUdpLidarSource(c), std::invalid_argument);
   c = UdpLidarConfig{};
   c.bind_address = "not-an-address";
