@@ -10,12 +10,17 @@
 namespace adit::pipeline {
 namespace fs = std::filesystem;
 
-RunSummary summarizeRun(const ReplayReport& replay, const std::string& out_dir, const Trajectory& ground_truth) {
+RunSummary summarizeRun(const ReplayReport& replay, const std::string& out_dir, const Trajectory& ground_truth,
+                        eval::AlignMode align) {
   RunSummary s;
   s.replay = replay;
   const fs::path dir(out_dir);
-  if (fs::exists(dir / "trajectory.tum")) s.final_eval = eval::evaluate(ground_truth, eval::readTum((dir / "trajectory.tum").string()));
-  if (fs::exists(dir / "odometry.tum")) s.odometry_eval = eval::evaluate(ground_truth, eval::readTum((dir / "odometry.tum").string()));
+  eval::EvalConfig config;
+  config.align = align;
+  if (fs::exists(dir / "trajectory.tum"))
+    s.final_eval = eval::evaluate(ground_truth, eval::readTum((dir / "trajectory.tum").string()), config);
+  if (fs::exists(dir / "odometry.tum"))
+    s.odometry_eval = eval::evaluate(ground_truth, eval::readTum((dir / "odometry.tum").string()), config);
   runtime::LogReader log((dir / "output.lcmlog").string());
   runtime::LogEvent e;
   while (log.next(e)) s.loops += e.channel == "LOOP_CLOSURE";
@@ -30,8 +35,10 @@ std::string formatRunReport(const RunSummary& s, const std::vector<std::string>&
                      s.replay.sensor_seconds, s.replay.sweeps);
   out += fmt::format("  loops closed         {}\n", s.loops);
   if (s.final_eval.valid) {
-    out += fmt::format("  APE rmse             {:.3f} m (max {:.3f} m) after loop closure\n", s.final_eval.ape_m.rmse,
-                       s.final_eval.ape_m.max);
+    out += fmt::format("  APE rmse             {:.3f} m (max {:.3f} m) after loop closure, {}-aligned\n",
+                       s.final_eval.ape_m.rmse, s.final_eval.ape_m.max, eval::toString(s.final_eval.align));
+    if (s.final_eval.align == eval::AlignMode::kSim3)
+      out += fmt::format("                       scale of the estimate {:.4f}\n", s.final_eval.alignment.scale);
     if (s.odometry_eval.valid)
       out += fmt::format("                       {:.3f} m (max {:.3f} m) before\n", s.odometry_eval.ape_m.rmse,
                          s.odometry_eval.ape_m.max);

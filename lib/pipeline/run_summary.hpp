@@ -19,8 +19,10 @@ struct RunSummary {
   double realtime_factor = 0;      // sensor seconds per wall second
 };
 
-// Reads out_dir's trajectories (and LOOP_CLOSURE from output.lcmlog, when it was recorded) after a replay.
-RunSummary summarizeRun(const ReplayReport& replay, const std::string& out_dir, const Trajectory& ground_truth);
+// Reads out_dir's trajectories (and LOOP_CLOSURE from output.lcmlog, when it was recorded) after a replay,
+// aligned onto the ground truth with `align` before any error (sim3 where the truth is known only up to scale).
+RunSummary summarizeRun(const ReplayReport& replay, const std::string& out_dir, const Trajectory& ground_truth,
+                        eval::AlignMode align = eval::AlignMode::kSE3);
 
 // The short report the demo ends with.
 std::string formatRunReport(const RunSummary& summary, const std::vector<std::string>& files);

@@ -5,9 +5,11 @@
 #include <adit/features_t.hpp>
 #include <adit/lidar_scan_t.hpp>
 #include <adit/point_cloud_t.hpp>
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <sstream>
 
 namespace fs = std::filesystem;
 using namespace adit::test;
@@ -203,6 +205,28 @@ TEST_F(Cli, AblationRunsTheThreeVariantsAndPrintsOneTable) {
   EXPECT_NE(out.find("rmse"), std::string::npos) << out;
   // The variants really differ: plain A-LOAM and the LinK3D-seeded pipeline do not give the same trajectory.
   EXPECT_NE(slurp(dir_ / "ablation" / "A-LOAM" / "trajectory.tum"), slurp(dir_ / "ablation" / "LinK3D" / "trajectory.tum"));
+
+  // Ground truth known only up to scale (here: 1.5 times too large): --align sim3 finds the scale and says so.
+  std::istringstream lines(slurp(gt));
+  std::ofstream scaled(dir_ / "ablation_gt_scaled.tum");
+  for (std::string line; std::getline(lines, line);) {
+    std::istringstream f(line);
+    double t, x, y, z, qx, qy, qz, qw;
+    if (!(f >> t >> x >> y >> z >> qx >> qy >> qz >> qw)) continue;
+    scaled << fmt::format("{:.6f} {:.6f} {:.6f} {:.6f} {} {} {} {}\n", t, 1.5 * x, 1.5 * y, 1.5 * z, qx, qy, qz, qw);
+  }
+  scaled.close();
+  ASSERT_EQ(run(bin("adit") + " bench ablation " + log.string() + " --gt " + (dir_ / "ablation_gt_scaled.tum").string() +
+                    " --align sim3 -o " + (dir_ / "ablation_sim3").string(),
+                dir_ / "ablation_sim3.txt"),
+            0)
+      << slurp(dir_ / "ablation_sim3.txt");
+  const std::string sim3 = slurp(dir_ / "ablation_sim3.txt");
+  EXPECT_NE(sim3.find("sim3-aligned"), std::string::npos) << sim3;
+  int scales = 0;
+  for (std::size_t at = sim3.find(", scale "); at != std::string::npos; at = sim3.find(", scale ", at + 1), ++scales)
+    EXPECT_NEAR(std::stod(sim3.substr(at + 8)), 1.5, 0.01) << sim3;
+  EXPECT_EQ(scales, 3) << sim3;
 }
 
 TEST_F(Cli, DemoEndsWithAReportAndPlots) {
