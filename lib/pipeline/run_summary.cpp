@@ -47,6 +47,11 @@ std::string formatRunReport(const RunSummary& s, const std::vector<std::string>&
   } else {
     out += "  APE                  not available: " + s.final_eval.message + "\n";
   }
+  if (s.map_accuracy.valid)
+    out += fmt::format("  map against world    {:.3f} m mean, {:.3f} m at the 95th percentile, {:.2f} % of {} points "
+                       "beyond 0.2 m\n",
+                       s.map_accuracy.mean_m, s.map_accuracy.p95_m, 100.0 * s.map_accuracy.beyond_02_m,
+                       s.map_accuracy.points);
   out += fmt::format("  speed                {:.1f} ms per sweep, {:.1f}x real time, peak memory {:.0f} MB\n",
                      s.ms_per_sweep, s.realtime_factor, s.replay.peak_memory_mb);
   for (const auto& f : files) out += "  " + f + "\n";

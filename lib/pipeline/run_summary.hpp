@@ -3,6 +3,7 @@
 
 #include "core/types.hpp"
 #include "eval/evaluate.hpp"
+#include "eval/map_accuracy.hpp"
 #include "pipeline/replay.hpp"
 
 #include <string>
@@ -17,6 +18,7 @@ struct RunSummary {
   int loops = 0;                   // LOOP_CLOSURE messages in output.lcmlog
   double ms_per_sweep = 0;         // wall time of the whole pipeline per sweep
   double realtime_factor = 0;      // sensor seconds per wall second
+  eval::MapAccuracy map_accuracy;  // map.pcd against the true surfaces, when they are known (the simulator's)
 };
 
 // Reads out_dir's trajectories (and LOOP_CLOSURE from output.lcmlog, when it was recorded) after a replay,

@@ -3,7 +3,9 @@
 // simulator's ground truth, plots it, and prints a short report.
 #include "commands.hpp"
 
+#include "eval/map_accuracy.hpp"
 #include "eval/plot.hpp"
+#include "io/pcd.hpp"
 #include "eval/trajectory_io.hpp"
 #include "pipeline/run_summary.hpp"
 #include "runtime/process.hpp"
@@ -70,7 +72,15 @@ void registerDemoCommand(CLI::App& app) {
 
     const std::string gt_path = (out / "ground_truth.tum").string();
     adit::eval::writeTum(gt_path, source.groundTruth());
-    const auto summary = adit::pipeline::summarizeRun(replay, out.string(), source.groundTruth());
+    auto summary = adit::pipeline::summarizeRun(replay, out.string(), source.groundTruth());
+    if (summary.final_eval.valid && fs::exists(out / "map.pcd")) {
+      // The saved map against the simulator's surfaces (sampled every 0.1 m), placed by the APE's alignment.
+      std::vector<Eigen::Vector3d> map, world;
+      for (const adit::LidarPoint& p : adit::io::readPcdScan((out / "map.pcd").string(), {}, 0, 0).points)
+        map.push_back(p.p.cast<double>());
+      for (const auto& p : source.simulator().worldPointCloud(0.1)) world.push_back(p.cast<double>());
+      summary.map_accuracy = adit::eval::mapAgainstWorld(map, world, summary.final_eval.alignment);
+    }
     std::vector<std::string> files{"map:        " + (out / "map.pcd").string(),
                                    "trajectory: " + (out / "trajectory.tum").string() + " (ground truth: " + gt_path + ")"};
     const std::string traj_png = (out / "trajectory.png").string(), map_png = (out / "map.png").string();
