@@ -70,13 +70,26 @@ ReplayRun replay(std::vector<runtime::OutgoingMessage> messages, const Trajector
   return run;
 }
 
-TEST(PcapReplay, SameAccuracyAsTheSimulatorsLog) {
+// The run both recordings are made of: 20 s of roadway-loop with a VLP-16 (200 sweeps, seed 4).
+sim::SimConfig twentySecondsOfRoadwayLoop() {
   sim::SimConfig sim = sim::simConfigFrom(pipelineConfig());
   sim.world = "roadway-loop";
   sim.sensor = "vlp16";
   sim.duration_s = 20.0;
   sim.seed = 4;
-  sources::SimSource source(sim, sources::SimChannels{});
+  return sim;
+}
+
+// Every message of the source, in order.
+std::vector<runtime::OutgoingMessage> drain(runtime::MessageSource& source) {
+  std::vector<runtime::OutgoingMessage> messages;
+  runtime::OutgoingMessage m;
+  while (source.next(m)) messages.push_back(m);
+  return messages;
+}
+
+TEST(PcapReplay, SameAccuracyAsTheSimulatorsLog) {
+  sources::SimSource source(twentySecondsOfRoadwayLoop(), sources::SimChannels{});
   const std::string pcap = (fs::temp_directory_path() / ("adit_pcap_replay_" + std::to_string(::getpid()) + ".pcap")).string();
   std::vector<runtime::OutgoingMessage> logged;
   std::int64_t packets = 0;
@@ -84,8 +97,7 @@ TEST(PcapReplay, SameAccuracyAsTheSimulatorsLog) {
     std::ofstream out(pcap, std::ios::binary);
     sources::SimPcapRecorder recorder(source.simulator().lidar(), out);
     source.addSweepObserver([&recorder](const LidarScan& scan) { recorder.addSweep(scan); });
-    runtime::OutgoingMessage m;
-    while (source.next(m)) logged.push_back(m);
+    logged = drain(source);
     packets = recorder.packets();
   }
   // The capture's sweeps in place of the log's, with the log's IMU (and ground truth) around them.
@@ -93,8 +105,7 @@ TEST(PcapReplay, SameAccuracyAsTheSimulatorsLog) {
   drivers::UdpLidarConfig lidar;
   lidar.model = "vlp16";
   auto capture = sources::makePcapLidarSource(pcap, lidar);
-  runtime::OutgoingMessage m;
-  while (capture->next(m)) from_pcap.push_back(m);
+  from_pcap = drain(*capture);
   const runtime::Health health = capture->health();
   fs::remove(pcap);
   for (const auto& message : logged)
@@ -121,19 +132,8 @@ TEST(PcapReplay, SameAccuracyAsTheSimulatorsLog) {
   EXPECT_LE(std::abs(pcap_run.ape_rmse_m - log_run.ape_rmse_m), 0.05 * log_run.ape_rmse_m);
 }
 
-}  // namespace
-}  // namespace adit
-
-namespace adit {
-namespace {
-
 TEST(BagReplay, SameAccuracyAsTheSimulatorsLog) {
-  sim::SimConfig sim = sim::simConfigFrom(pipelineConfig());
-  sim.world = "roadway-loop";
-  sim.sensor = "vlp16";
-  sim.duration_s = 20.0;
-  sim.seed = 4;
-  sources::SimSource source(sim, sources::SimChannels{});
+  sources::SimSource source(twentySecondsOfRoadwayLoop(), sources::SimChannels{});
   const std::string bag = (fs::temp_directory_path() / ("adit_bag_replay_" + std::to_string(::getpid()) + ".bag")).string();
   std::vector<runtime::OutgoingMessage> logged;
   std::int64_t bag_messages = 0;
@@ -142,8 +142,7 @@ TEST(BagReplay, SameAccuracyAsTheSimulatorsLog) {
     sources::SimBagRecorder recorder(out, "lz4");
     source.addSweepObserver([&recorder](const LidarScan& scan) { recorder.addSweep(scan); });
     source.addImuObserver([&recorder](const ImuSample& s) { recorder.addImu(s); });
-    runtime::OutgoingMessage m;
-    while (source.next(m)) logged.push_back(m);
+    logged = drain(source);
     recorder.finish();
     bag_messages = recorder.messages();
   }
@@ -154,9 +153,7 @@ TEST(BagReplay, SameAccuracyAsTheSimulatorsLog) {
   config.imu_topic = "/imu/data";
   config.cloud.sensor = "vlp16";
   auto reader = sources::makeRosbagSource(bag, config);
-  std::vector<runtime::OutgoingMessage> from_bag;
-  runtime::OutgoingMessage m;
-  while (reader->next(m)) from_bag.push_back(m);
+  const std::vector<runtime::OutgoingMessage> from_bag = drain(*reader);
   const runtime::Health health = reader->health();
   fs::remove(bag);
   const auto count = [](const std::vector<runtime::OutgoingMessage>& messages, const std::string& channel) {
