@@ -41,6 +41,7 @@ int main(int argc, char** argv) {
   registerSpyCommand(app);
   registerEvalCommand(app);
   registerCommandCommand(app);
+  registerExportCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
