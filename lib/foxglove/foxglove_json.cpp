@@ -1,8 +1,7 @@
 #include "foxglove/foxglove_json.hpp"
 
+#include "core/base64.hpp"
 #include "core/json_writer.hpp"
-
-#include <openssl/evp.h>
 
 #include <algorithm>
 #include <cstring>
@@ -42,14 +41,6 @@ void appendFloat(std::string& out, float v) {
 }
 
 }  // namespace
-
-std::string base64(const std::string& bytes) {
-  std::string out(4 * ((bytes.size() + 2) / 3) + 1, '\0');
-  const int n = EVP_EncodeBlock(reinterpret_cast<unsigned char*>(out.data()),
-                                reinterpret_cast<const unsigned char*>(bytes.data()), static_cast<int>(bytes.size()));
-  out.resize(static_cast<std::size_t>(n));
-  return out;
-}
 
 std::string pointCloudJson(std::int64_t utime, const std::string& frame_id, const std::vector<Eigen::Vector3f>& points,
                            const std::vector<float>* intensity) {

@@ -23,7 +23,4 @@ std::string lineListSceneJson(std::int64_t utime, const std::string& frame_id, c
                               const std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>>& segments);
 std::string statusJson(const view::StatusRow& row);
 
-// Standard base64 with padding (RFC 4648).
-std::string base64(const std::string& bytes);
-
 }  // namespace adit::foxglove

@@ -4,12 +4,11 @@
 
 #include "foxglove/mcap_export.hpp"
 #include "io/atomic_file.hpp"
-#include "runtime/lcm_log.hpp"
+#include "view/merged_logs.hpp"
 
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
-#include <memory>
 
 namespace {
 
@@ -21,48 +20,11 @@ struct ExportArgs {
   adit::foxglove::ExportOptions options;
 };
 
-// The events of several logs in time order (ties: the earlier log first, then each log's own order).
-class MergedLogs {
- public:
-  explicit MergedLogs(const std::vector<std::string>& paths) {
-    for (const auto& p : paths) {
-      readers_.push_back(std::make_unique<adit::runtime::LogReader>(p));
-      heads_.emplace_back();
-      live_.push_back(readers_.back()->next(heads_.back()));
-    }
-  }
-  bool next(adit::runtime::LogEvent& out) {
-    int best = -1;
-    for (std::size_t i = 0; i < readers_.size(); ++i)
-      if (live_[i] && (best < 0 || heads_[i].timestamp < heads_[static_cast<std::size_t>(best)].timestamp))
-        best = static_cast<int>(i);
-    if (best < 0) return false;
-    const auto b = static_cast<std::size_t>(best);
-    out = std::move(heads_[b]);
-    live_[b] = readers_[b]->next(heads_[b]);
-    return true;
-  }
-  // Corrupt frames and truncations over all logs, one line each.
-  std::vector<std::string> damage(const std::vector<std::string>& paths) const {
-    std::vector<std::string> lines;
-    for (std::size_t i = 0; i < readers_.size(); ++i)
-      if (readers_[i]->corruptFrames() || readers_[i]->truncated())
-        lines.push_back(fmt::format("log '{}' is damaged: {} corrupt frame(s) skipped{}", paths[i],
-                                    readers_[i]->corruptFrames(), readers_[i]->truncated() ? ", truncated" : ""));
-    return lines;
-  }
-
- private:
-  std::vector<std::unique_ptr<adit::runtime::LogReader>> readers_;
-  std::vector<adit::runtime::LogEvent> heads_;
-  std::vector<bool> live_;
-};
-
 void runExport(const ExportArgs& args) {
   adit::io::McapOptions mcap;
   mcap.compression = args.compression == "none" ? adit::io::McapCompression::None : adit::io::McapCompression::Zstd;
   mcap.chunk_bytes = args.chunk_mb << 20;
-  MergedLogs logs(args.logs);
+  adit::view::MergedLogs logs(args.logs);
   std::uint64_t events = 0;
   std::map<std::string, std::uint64_t> topics;
   adit::view::DecodeCounts counts;
@@ -86,7 +48,7 @@ void runExport(const ExportArgs& args) {
   if (counts.malformed || counts.out_of_order)
     spdlog::warn("{} malformed message(s) and {} pose(s) out of order skipped (last: {})", counts.malformed,
                  counts.out_of_order, counts.last_error);
-  const auto damage = logs.damage(args.logs);
+  const auto damage = logs.damage();
   for (const auto& line : damage) spdlog::error("{}", line);
   if (!damage.empty()) throw CLI::RuntimeError(kExitDamagedInput);
 }

@@ -42,6 +42,7 @@ int main(int argc, char** argv) {
   registerEvalCommand(app);
   registerCommandCommand(app);
   registerExportCommand(app);
+  registerViewCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
