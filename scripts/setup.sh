@@ -16,6 +16,7 @@ PACKAGES=(
   python3-numpy python3-matplotlib
   libssl-dev libbz2-dev liblz4-dev libzstd-dev
   iproute2 util-linux nftables
+  nodejs npm chromium
 )
 
 missing=()

@@ -145,7 +145,7 @@ void ViewSession::sendInfo(int client, const std::string& extra_json) {
   j.field("bytes_sent", server_.bytesSent(client)).field("last_error", counts.last_error).endObject();
   j.key("status").beginArray();
   for (const auto& [name, row] : model_.status) statusRow(j, row);
-  j.endArray();
+  j.endArray().endObject();
   std::string json = j.str();
   if (!extra_json.empty()) json.insert(json.size() - 1, "," + extra_json);
   server_.send(client, encodeInfo(json));
