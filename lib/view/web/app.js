@@ -141,6 +141,19 @@ function reset() {
   loops.geometry = new THREE.BufferGeometry();
 }
 
+// Measurement only (?stress_points=N): N extra points along a 600 m synthetic roadway, in 0.5 m voxels' worth
+// of 10,000-point submaps, to measure the frame time with a large map (README, "Watching a run").
+const stress = Number(new URLSearchParams(location.search).get("stress_points") || 0);
+for (let done = 0, id = 1000000; done < stress; ++id) {
+  const n = Math.min(10000, stress - done), points = new Float32Array(3 * n);
+  for (let i = 0; i < n; ++i) {
+    const a = Math.random() * 2 * Math.PI, x = Math.random() * 600 - 300;
+    points.set([x, 2.5 * Math.cos(a), 1.5 + 2 * Math.sin(a)], 3 * i);
+  }
+  addSubmap({ id, version: 0, pose: { position: [0, 0, 0], quaternion: [0, 0, 0, 1] }, points });
+  done += n;
+}
+
 // --- panel --------------------------------------------------------------------------------------------------
 const $ = (id) => document.getElementById(id);
 let bandwidth = { bytes: 0, since: performance.now(), rate: 0 };

@@ -1,6 +1,7 @@
 // Opens adit view's page in Debian's chromium (headless, software GL), waits until the map has points, the
 // trajectory has poses and the STATUS panel has rows, prints window.aditState as JSON and saves a screenshot.
-//   node view_page.js URL SCREENSHOT.png [TIMEOUT_S [MEASURE_S]]   ($CHROMIUM: the browser, default /usr/bin/chromium)
+//   node view_page.js URL SCREENSHOT.png [TIMEOUT_S [MEASURE_S]]   ($CHROMIUM: the browser, default /usr/bin/chromium;
+//   $ADIT_VIEW_MODE: top or follow for the screenshot)
 // MEASURE_S: for a log started --paused, press play once connected and measure the stream's bytes per second
 // over that many seconds (state.measured), before the checks (which then need no STATUS row).
 "use strict";
@@ -41,6 +42,7 @@ async function main() {
       await page.screenshot({ path: screenshot });
       process.exit(1);
     }
+    if (process.env.ADIT_VIEW_MODE) await page.click(`#view-${process.env.ADIT_VIEW_MODE}`);  // orbit, top, follow
     await new Promise((r) => setTimeout(r, 1500));  // a few more frames drawn
     const state = await page.evaluate(() => JSON.parse(JSON.stringify(window.aditState)));
     state.page_errors = errors;
