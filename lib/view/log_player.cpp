@@ -18,7 +18,11 @@ LogPlayer::LogPlayer(std::vector<std::string> paths, double speed, bool playing)
     last_utime_ = std::max(last_utime_, e.timestamp);
     any = true;
   }
-  if (!any) throw std::runtime_error("the log(s) hold no LCM event");
+  if (!any) {
+    std::string names;
+    for (const auto& p : paths_) names += (names.empty() ? "'" : ", '") + p + "'";
+    throw std::runtime_error(names + ": no LCM event (empty, or not an LCM log)");
+  }
   logs_ = std::make_unique<MergedLogs>(paths_);
 }
 

@@ -24,6 +24,12 @@ bool MergedLogs::next(runtime::LogEvent& out) {
   return true;
 }
 
+bool MergedLogs::empty() const {
+  for (const bool live : live_)
+    if (live) return false;
+  return true;
+}
+
 std::vector<std::string> MergedLogs::damage() const {
   std::vector<std::string> lines;
   for (std::size_t i = 0; i < readers_.size(); ++i)

@@ -14,6 +14,8 @@ class MergedLogs {
  public:
   explicit MergedLogs(std::vector<std::string> paths);  // throws if a log cannot be opened
   bool next(runtime::LogEvent& out);
+  // True when no log holds any event (before the first next()).
+  bool empty() const;
   // One line per damaged log ("" lines are left out).
   std::vector<std::string> damage() const;
 

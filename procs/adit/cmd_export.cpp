@@ -25,6 +25,9 @@ void runExport(const ExportArgs& args) {
   mcap.compression = args.compression == "none" ? adit::io::McapCompression::None : adit::io::McapCompression::Zstd;
   mcap.chunk_bytes = args.chunk_mb << 20;
   adit::view::MergedLogs logs(args.logs);
+  if (logs.empty())
+    throw std::runtime_error(fmt::format("'{}' hold(s) no LCM event (empty, or not an LCM log): nothing exported",
+                                         fmt::join(args.logs, "', '")));
   std::uint64_t events = 0;
   std::map<std::string, std::uint64_t> topics;
   adit::view::DecodeCounts counts;
@@ -41,7 +44,6 @@ void runExport(const ExportArgs& args) {
     topics = exporter.topics();
     counts = exporter.decodeCounts();
   });
-  if (events == 0) spdlog::warn("no LCM event in the input: '{}' holds no message", args.out);
   fmt::print("{} events read, {} used; wrote {}\n", events, counts.used, args.out);
   for (const auto& [topic, n] : topics) fmt::print("  {:<26} {:>8} messages\n", topic, n);
   for (const auto& [channel, n] : counts.ignored) fmt::print("  not exported: {:<16} {:>8} messages\n", channel, n);
