@@ -98,8 +98,10 @@ class Path {
   constructor(colour) {
     this.data = new Float32Array(3 * 1024);
     this.n = 0;
-    this.line = new THREE.Line(new THREE.BufferGeometry(), new THREE.LineBasicMaterial({ color: colour }));
+    // Drawn over the map (depth test off): a trajectory runs inside the roadway, under its roof.
+    this.line = new THREE.Line(new THREE.BufferGeometry(), new THREE.LineBasicMaterial({ color: colour, depthTest: false }));
     this.line.frustumCulled = false;
+    this.line.renderOrder = 1;
     scene.add(this.line);
     this.upload();
   }
@@ -125,8 +127,9 @@ class Path {
 const paths = [new Path(0x888888), new Path(0x40e040), new Path(0x4090ff)];  // odometry, corrected, truth
 const kinds = ["odometry", "corrected", "ground_truth"];
 
-const loops = new THREE.LineSegments(new THREE.BufferGeometry(), new THREE.LineBasicMaterial({ color: 0xff40d0 }));
+const loops = new THREE.LineSegments(new THREE.BufferGeometry(), new THREE.LineBasicMaterial({ color: 0xff40d0, depthTest: false }));
 loops.frustumCulled = false;
+loops.renderOrder = 2;
 scene.add(loops);
 const robot = new THREE.AxesHelper(2);
 scene.add(robot);
@@ -246,9 +249,13 @@ for (const mode of ["orbit", "top", "follow"]) {
 function followCamera() {
   if (!robotPose) return;
   const p = new THREE.Vector3(...robotPose.position);
-  if (viewMode === "top") {
-    camera.position.set(p.x, p.y - 0.01, p.z + 80);
-    camera.lookAt(p);
+  if (viewMode === "top") {  // the whole trajectory from above
+    const path = paths[1].n ? paths[1] : paths[0];
+    const box = new THREE.Box3().setFromArray(path.data.subarray(0, 3 * path.n)).expandByPoint(p);
+    const centre = box.getCenter(new THREE.Vector3()), size = box.getSize(new THREE.Vector3());
+    const extent = Math.max(size.x / camera.aspect, size.y, 20) + 50;  // the map reaches past the path
+    camera.position.set(centre.x, centre.y - 0.01, centre.z + extent / (2 * Math.tan((camera.fov * Math.PI) / 360)));
+    camera.lookAt(centre);
   } else if (viewMode === "follow") {
     const q = new THREE.Quaternion(...robotPose.quaternion);
     const behind = new THREE.Vector3(-12, 0, 6).applyQuaternion(q);
