@@ -98,6 +98,7 @@ void runView(const ViewArgs& a) {
                player ? fmt::format("{} log(s), {:.1f} s", a.logs.size(), player->duration()) : "live LCM",
                a.bind == "127.0.0.1" ? "; this computer only: --bind 0.0.0.0 serves the LAN" : "; read-only");
   adit::runtime::installStopHandlers();
+  const std::string commands_json = a.allow_commands ? "\"commands_allowed\":true" : "";
   const auto start = Clock::now();
   auto last = start, last_report = start;
   while (!adit::runtime::stopRequested()) {
@@ -110,7 +111,7 @@ void runView(const ViewArgs& a) {
     last = now;
     if (player) player->advance(dt, session);
     handleCommands(server, session, player.get(), lcm.get(), a.allow_commands);
-    session.tick(elapsed, player ? player->infoJson() : "");
+    session.tick(elapsed, player ? player->infoJson() : commands_json);
     if (now - last_report >= std::chrono::seconds(10)) {
       const auto& c = server.counters();
       spdlog::info("{} client(s); sent {:.2f} MB ({:.3f} MB/s since start), {} frame(s) dropped; {} malformed message(s)",

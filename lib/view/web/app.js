@@ -182,6 +182,7 @@ function showInfo(info) {
       (counters || error ? `<tr><td colspan="5" class="counters">${escape(counters + error)}</td></tr>` : "");
   });
   $("status").tBodies[0].innerHTML = rows.join("");
+  $("commands").hidden = !info.commands_allowed;  // adit view --allow-commands, live runs only
   if (info.log) {
     $("playback").hidden = false;
     const slider = $("slider");
@@ -234,6 +235,7 @@ const send = (text) => socket && socket.readyState === 1 && socket.send(text);
 $("slider").addEventListener("change", (e) => send(`seek ${e.target.value}`));
 $("play").addEventListener("click", () => send($("play").textContent === "pause" ? "pause" : "play"));
 $("speed").addEventListener("change", (e) => send(`speed ${e.target.value}`));
+$("save-map").addEventListener("click", () => send(`save_map ${$("map-name").value.trim()}`.trim()));
 $("colour").addEventListener("change", (e) => { colourBy = e.target.value; if (lastSweep) showSweep(lastSweep); });
 
 // --- views and rendering ------------------------------------------------------------------------------------

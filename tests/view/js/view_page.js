@@ -1,7 +1,7 @@
 // Opens adit view's page in Debian's chromium (headless, software GL), waits until the map has points, the
 // trajectory has poses and the STATUS panel has rows, prints window.aditState as JSON and saves a screenshot.
 //   node view_page.js URL SCREENSHOT.png [TIMEOUT_S [MEASURE_S]]   ($CHROMIUM: the browser, default /usr/bin/chromium;
-//   $ADIT_VIEW_MODE: top or follow for the screenshot)
+//   $ADIT_VIEW_MODE: top or follow for the screenshot; $ADIT_SAVE_MAP: see below)
 // MEASURE_S: for a log started --paused, press play once connected and measure the stream's bytes per second
 // over that many seconds (state.measured), before the checks (which then need no STATUS row).
 "use strict";
@@ -43,6 +43,12 @@ async function main() {
       process.exit(1);
     }
     if (process.env.ADIT_VIEW_MODE) await page.click(`#view-${process.env.ADIT_VIEW_MODE}`);  // orbit, top, follow
+    // $ADIT_SAVE_MAP=a,b: type each name into the page's save-map field and press the button (--allow-commands).
+    for (const name of (process.env.ADIT_SAVE_MAP || "").split(",").filter((n) => n)) {
+      await page.$eval("#map-name", (el, v) => { el.value = v; }, name);
+      await page.click("#save-map");
+      await new Promise((r) => setTimeout(r, 500));
+    }
     await new Promise((r) => setTimeout(r, 1500));  // a few more frames drawn
     const state = await page.evaluate(() => JSON.parse(JSON.stringify(window.aditState)));
     state.page_errors = errors;
