@@ -84,7 +84,8 @@ void ViewSession::tick(double now_s, const std::string& extra_json) {
 }
 
 void ViewSession::sendMap(int client, ClientState& s) {
-  std::size_t bytes = 0;
+  // New submaps go out as the client drains them (a late joiner to a large map is not flooded into drops).
+  std::size_t bytes = server_.queuedBytes(client);
   for (const auto& [id, submap] : model_.submaps) {
     const auto have = s.submaps.find(id);
     if (have == s.submaps.end()) {

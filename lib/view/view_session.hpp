@@ -18,7 +18,7 @@ struct ViewOptions {
   std::size_t sweep_points = 6000;         // points of a sweep sent (every k-th)
   double sweep_rate_hz = 5.0;              // sweeps sent per second at most
   double info_rate_hz = 1.0;               // STATUS / facts frames per second
-  std::size_t submap_bytes_per_tick = 256u << 10;  // a late joiner receives the map over several ticks
+  std::size_t submap_bytes_per_tick = 256u << 10;  // new submaps wait while a client has this much queued
 };
 
 class ViewSession {

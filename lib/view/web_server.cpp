@@ -351,6 +351,12 @@ std::int64_t WebServer::bytesSent(int client) const {
   return 0;
 }
 
+std::size_t WebServer::queuedBytes(int client) const {
+  for (const auto& [fd, c] : connections_)
+    if (c->client == client) return c->queued_bytes;
+  return 0;
+}
+
 std::vector<std::pair<int, std::string>> WebServer::takeMessages() { return std::exchange(messages_, {}); }
 std::vector<std::pair<int, int>> WebServer::takeDropped() { return std::exchange(dropped_, {}); }
 std::vector<int> WebServer::takeClosed() { return std::exchange(closed_, {}); }

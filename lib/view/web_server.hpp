@@ -46,8 +46,9 @@ class WebServer {
   std::vector<int> clients() const;
   // Queues a binary frame for a client; `tag` comes back from takeDropped() if the frame is dropped.
   void send(int client, const std::string& payload, int tag = -1);
-  // Bytes sent to the client so far (WebSocket frames, headers included).
+  // Bytes sent to the client so far (WebSocket frames, headers included), and bytes waiting in its queue.
   std::int64_t bytesSent(int client) const;
+  std::size_t queuedBytes(int client) const;
   std::vector<std::pair<int, std::string>> takeMessages();  // (client, text) received
   std::vector<std::pair<int, int>> takeDropped();           // (client, tag) of dropped frames
   std::vector<int> takeClosed();                            // clients gone since the last call

@@ -211,3 +211,76 @@ TEST(McapExport, EveryTopicOfTheRunIsWritten) {
 }
 
 }  // namespace
+
+// The session sends a browser only what it lacks: a late joiner gets every submap once (flow-controlled,
+// nothing dropped), then a loop's move arrives as a pose only; trajectories are appended.
+#include "view/view_session.hpp"
+#include "view/view_stream.hpp"
+#include "ws_client.hpp"
+
+namespace {
+
+adit::map_update_t bigUpdate(int first_id, int count, std::int64_t utime) {
+  adit::map_update_t m{};
+  setHeader(m.header, utime);
+  for (int id = first_id; id < first_id + count; ++id) {
+    adit::map_submap_t s{};
+    s.id = id;
+    s.utime = utime;
+    adit::splitPose(poseXYZYaw(id, 0, 0, 0), s.position, s.orientation);
+    for (int i = 0; i < 5000; ++i) s.points.push_back({0.01f * static_cast<float>(i % 100), 0.02f * static_cast<float>(i / 100), 1.0f});
+    s.num_points = 5000;
+    m.new_submaps.push_back(s);
+  }
+  m.num_new = count;
+  m.num_submaps = first_id + count;
+  return m;
+}
+
+TEST(ViewSession, LateJoinerGetsTheMapOnceThenOnlyWhatChanged) {
+  adit::view::WebServer server({"127.0.0.1", 0, "."});
+  adit::view::ViewSession session(server, {});
+  const auto feed = [&](const std::string& channel, const std::vector<std::uint8_t>& bytes) {
+    session.apply(channel, bytes.data(), bytes.size());
+  };
+  feed("MAP_UPDATE", adit::msg::encode(bigUpdate(0, 80, 1000000)));  // 80 x 30 kB: more than one tick's share
+  const Eigen::Isometry3d I = Eigen::Isometry3d::Identity();
+  for (int i = 1; i <= 20; ++i) feed("ODOM_MAPPED", adit::msg::encode(odometry(i * 100000, poseXYZYaw(0.1 * i, 0, 0, 0), I)));
+
+  adit::test::WsClient client(server, server.port());
+  ASSERT_TRUE(client.ok());
+  std::map<int, int> submap_frames, pose_frames;
+  std::size_t odometry_points = 0;
+  double t = 0;
+  const auto run = [&](int ticks) {
+    for (int k = 0; k < ticks; ++k) {
+      session.tick(t += 0.05, "");
+      for (const std::string& bytes : client.frames(5)) {
+        adit::view::DecodedFrame f;
+        ASSERT_TRUE(adit::view::decodeFrame(bytes, f));
+        if (f.type == adit::view::FrameType::Submap) ++submap_frames[static_cast<int>(f.id)];
+        if (f.type == adit::view::FrameType::SubmapPose) ++pose_frames[static_cast<int>(f.id)];
+        if (f.type == adit::view::FrameType::Trajectory && f.kind == adit::view::TrajectoryKind::Odometry)
+          odometry_points = (f.replace ? 0 : odometry_points) + f.points.size();
+      }
+    }
+  };
+  run(60);
+  EXPECT_EQ(submap_frames.size(), 80u);
+  for (const auto& [id, n] : submap_frames) EXPECT_EQ(n, 1) << "submap " << id;
+  EXPECT_TRUE(pose_frames.empty());
+  EXPECT_EQ(odometry_points, 20u);
+  EXPECT_EQ(server.counters().frames_dropped, 0);
+
+  // A loop moves submap 7; two more poses.
+  feed("MAP_UPDATE", adit::msg::encode(mapUpdate(3000000, poseXYZYaw(7, 0.3, 0, 0), false)));  // moves id 0
+  for (int i = 21; i <= 22; ++i) feed("ODOM_MAPPED", adit::msg::encode(odometry(i * 100000, poseXYZYaw(0.1 * i, 0, 0, 0), I)));
+  const std::int64_t before = server.bytesSent(server.clients().at(0));
+  run(10);
+  EXPECT_EQ(pose_frames, (std::map<int, int>{{0, 1}}));
+  for (const auto& [id, n] : submap_frames) EXPECT_EQ(n, 1) << "submap " << id << " resent";
+  EXPECT_EQ(odometry_points, 22u);
+  EXPECT_LT(server.bytesSent(server.clients().at(0)) - before, 2000);  // a pose, two positions, info: no points
+}
+
+}  // namespace
