@@ -109,6 +109,11 @@ void ViewSession::sendTrajectories(int client, ClientState& s) {
                  tag(kOdometryStream));
     s.odometry = model_.odometry.size();
   }
+  if (s.keyframes_version != keyframes_version_) {
+    std::vector<TimedPose> keyframes;
+    for (const auto& [utime, pose] : model_.keyframes) keyframes.push_back({utime, pose});
+    server_.send(client, encodeTrajectory(TrajectoryKind::Keyframes, true, keyframes, 0), tag(kCorrectedStream));
+  }
   if (s.keyframes_version != keyframes_version_ || model_.odometry.size() != s.corrected) {
     const bool replace = s.keyframes_version != keyframes_version_ || s.corrected > model_.odometry.size();
     const auto corrected = model_.correctedTrajectory();

@@ -3,7 +3,7 @@
 //   Submap      u32 id, u32 version, pose, u32 n, n x (i16 x, y, z) at 1 cm in the keyframe frame
 //   SubmapPose  u32 id, u32 version, pose                      (a loop moved it: its points are already there)
 //   Sweep       i64 utime, pose, u32 n, n x (i16 x, y, z) at 1 cm in the lidar frame, n x u8 intensity
-//   Trajectory  u8 kind (0 odometry, 1 corrected, 2 ground truth), u8 replace (1) or append (0),
+//   Trajectory  u8 kind (0 odometry, 1 corrected, 2 ground truth, 3 corrected keyframes), u8 replace (1) or append (0),
 //               u32 n, n x (f32 x, y, z) world positions
 //   Loops       u32 n, n x (f32 x, y, z, x, y, z): segments between the loop's corrected keyframes
 //   Robot       i64 utime, pose
@@ -22,7 +22,7 @@
 namespace adit::view {
 
 enum class FrameType : std::uint8_t { Submap = 1, SubmapPose = 2, Sweep = 3, Trajectory = 4, Loops = 5, Robot = 6, Info = 7, Reset = 8 };
-enum class TrajectoryKind : std::uint8_t { Odometry = 0, Corrected = 1, GroundTruth = 2 };
+enum class TrajectoryKind : std::uint8_t { Odometry = 0, Corrected = 1, GroundTruth = 2, Keyframes = 3 };
 
 constexpr float kPointScale = 0.01f;  // metres per i16 count
 

@@ -6,7 +6,7 @@ import { decodeFrame, FrameType } from "./stream.js";
 
 const state = (window.aditState = {
   connected: false, frames: 0, bytes: 0, map_points: 0, submaps: 0, sweep_points: 0,
-  trajectory: { odometry: 0, corrected: 0, ground_truth: 0 }, loops: 0, status: [], info: null,
+  trajectory: { odometry: 0, corrected: 0, ground_truth: 0, keyframes: 0 }, loops: 0, status: [], info: null,
   frame_ms: 0, rendered_frames: 0,
 });
 
@@ -125,7 +125,19 @@ class Path {
   }
 }
 const paths = [new Path(0x888888), new Path(0x40e040), new Path(0x4090ff)];  // odometry, corrected, truth
-const kinds = ["odometry", "corrected", "ground_truth"];
+const kinds = ["odometry", "corrected", "ground_truth", "keyframes"];
+// Keyframes (corrected): white dots over the map.
+const keyframes = new THREE.Points(new THREE.BufferGeometry(),
+  new THREE.PointsMaterial({ color: 0xffffff, size: 5, sizeAttenuation: false, depthTest: false }));
+keyframes.frustumCulled = false;
+keyframes.renderOrder = 3;
+scene.add(keyframes);
+function showKeyframes(positions) {
+  keyframes.geometry.dispose();
+  keyframes.geometry = new THREE.BufferGeometry();
+  keyframes.geometry.setAttribute("position", new THREE.BufferAttribute(positions, 3));
+  state.trajectory.keyframes = positions.length / 3;
+}
 
 const loops = new THREE.LineSegments(new THREE.BufferGeometry(), new THREE.LineBasicMaterial({ color: 0xff40d0, depthTest: false }));
 loops.frustumCulled = false;
@@ -140,6 +152,7 @@ function reset() {
   submaps.clear();
   state.map_points = 0; state.submaps = 0; state.loops = 0;
   for (const p of paths) p.update(new Float32Array(0), true);
+  showKeyframes(new Float32Array(0));
   for (const k of kinds) state.trajectory[k] = 0;
   loops.geometry = new THREE.BufferGeometry();
 }
@@ -215,6 +228,7 @@ function connect() {
       case FrameType.SubmapPose: { const p = submaps.get(frame.id); if (p) place(p, frame.pose); break; }
       case FrameType.Sweep: showSweep(frame); break;
       case FrameType.Trajectory:
+        if (frame.kind === 3) { showKeyframes(frame.positions); break; }
         paths[frame.kind].update(frame.positions, frame.replace);
         state.trajectory[kinds[frame.kind]] = paths[frame.kind].n;
         break;
