@@ -26,7 +26,7 @@ LogPlayer::LogPlayer(std::vector<std::string> paths, double speed, bool playing)
   logs_ = std::make_unique<MergedLogs>(paths_);
 }
 
-void LogPlayer::rewind(ViewSession& session) {
+void LogPlayer::rewind(RunConsumer& session) {
   logs_ = std::make_unique<MergedLogs>(paths_);
   pending_valid_ = false;
   more_ = true;
@@ -34,7 +34,7 @@ void LogPlayer::rewind(ViewSession& session) {
   session.reset();
 }
 
-void LogPlayer::feedTo(double position_s, ViewSession& session) {
+void LogPlayer::feedTo(double position_s, RunConsumer& session) {
   position_s_ = std::clamp(position_s, 0.0, duration());
   const auto until = first_utime_ + static_cast<std::int64_t>(position_s_ * 1e6);
   while (more_) {
@@ -44,17 +44,17 @@ void LogPlayer::feedTo(double position_s, ViewSession& session) {
       if (!more_) break;
     }
     if (pending_.timestamp > until) break;
-    session.apply(pending_.channel, pending_.data.data(), pending_.data.size());
+    session.apply(pending_.channel, pending_.data.data(), pending_.data.size(), pending_.timestamp);
     pending_valid_ = false;
   }
 }
 
-void LogPlayer::advance(double wall_dt_s, ViewSession& session) {
+void LogPlayer::advance(double wall_dt_s, RunConsumer& session) {
   if (playing_) feedTo(position_s_ + wall_dt_s * speed_, session);
   if (position_s_ >= duration()) playing_ = false;
 }
 
-bool LogPlayer::command(const std::string& text, ViewSession& session) {
+bool LogPlayer::command(const std::string& text, RunConsumer& session) {
   std::istringstream in(text);
   std::string verb;
   double value = 0;

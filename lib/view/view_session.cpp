@@ -20,7 +20,7 @@ void statusRow(JsonWriter& j, const StatusRow& r) {
 
 }  // namespace
 
-void ViewSession::apply(const std::string& channel, const std::uint8_t* data, std::size_t size) {
+void ViewSession::apply(const std::string& channel, const std::uint8_t* data, std::size_t size, std::int64_t) {
   const unsigned changed = decoder_.apply(channel, data, size, model_);
   if (changed & kKeyframesChanged) ++keyframes_version_;
   if (changed & (kKeyframesChanged | kLoopsChanged)) ++loops_version_;
@@ -56,12 +56,12 @@ void ViewSession::forgetDropped() {
       default: break;
     }
   }
-  for (const int client : server_.takeClosed()) clients_.erase(client);
 }
 
 void ViewSession::tick(double now_s, const std::string& extra_json) {
   forgetDropped();
   for (const int client : server_.clients()) {
+    if (!server_.subprotocol(client).empty()) continue;  // another protocol's client (Foxglove)
     ClientState& s = clients_[client];
     sendMap(client, s);
     sendTrajectories(client, s);

@@ -5,6 +5,7 @@
 // from a full queue is resent whole later (its stream is marked unsent). Sending never waits for a browser.
 #pragma once
 
+#include "view/run_consumer.hpp"
 #include "view/run_decoder.hpp"
 #include "view/web_server.hpp"
 
@@ -21,17 +22,19 @@ struct ViewOptions {
   std::size_t submap_bytes_per_tick = 256u << 10;  // new submaps wait while a client has this much queued
 };
 
-class ViewSession {
+class ViewSession : public RunConsumer {
  public:
   ViewSession(WebServer& server, ViewOptions options) : server_(server), options_(options) {}
 
   // One LCM message of the run.
-  void apply(const std::string& channel, const std::uint8_t* data, std::size_t size);
+  void apply(const std::string& channel, const std::uint8_t* data, std::size_t size, std::int64_t utime = 0) override;
   // Sends each client what it lacks. now_s: a monotonic clock (rates); extra_json: members added to the
   // info frame (e.g. "\"log\":{...}"), may be empty.
   void tick(double now_s, const std::string& extra_json);
   // Forget the run (a log rewound): every client is told to clear.
-  void reset();
+  void reset() override;
+  // A client disconnected.
+  void forget(int client) { clients_.erase(client); }
 
   const RunModel& model() const { return model_; }
   const DecodeCounts& decodeCounts() const { return decoder_.counts(); }

@@ -73,6 +73,7 @@ void setNonBlocking(int fd) { ::fcntl(fd, F_SETFL, ::fcntl(fd, F_GETFL, 0) | O_N
 struct WebServer::Connection {
   int fd = -1;
   int client = 0;  // > 0 once a WebSocket
+  std::string subprotocol;
   bool close_after_write = false;
   std::string in;
   std::string fragments;  // a fragmented client message so far
@@ -228,9 +229,15 @@ void WebServer::handleHttp(Connection& c) {
       ++counters_.bad_requests;
       return respond(c, 400, "text/plain", "WebSocket upgrade expected\n");
     }
+    // A subprotocol the client offers and we speak (Sec-WebSocket-Protocol: a comma-separated list).
+    std::istringstream offered(headers["sec-websocket-protocol"]);
+    for (std::string p; std::getline(offered, p, ',');)
+      if (c.subprotocol.empty() && std::count(options_.subprotocols.begin(), options_.subprotocols.end(), trim(p)))
+        c.subprotocol = trim(p);
     queue(c,
           "HTTP/1.1 101 Switching Protocols\r\nUpgrade: websocket\r\nConnection: Upgrade\r\nSec-WebSocket-Accept: " +
-              webSocketAccept(key) + "\r\n\r\n",
+              webSocketAccept(key) + "\r\n" +
+              (c.subprotocol.empty() ? "" : "Sec-WebSocket-Protocol: " + c.subprotocol + "\r\n") + "\r\n",
           -1, false);
     c.client = next_client_++;
     ++counters_.clients_total;
@@ -304,9 +311,15 @@ void WebServer::queue(Connection& c, std::string bytes, int tag, bool frame) {
   // Written by poll() when the socket can take it (writing here could close the connection under the caller).
 }
 
-void WebServer::send(int client, const std::string& payload, int tag) {
+void WebServer::send(int client, const std::string& payload, int tag, int opcode) {
   for (auto& [fd, c] : connections_)
-    if (c->client == client && !c->close_after_write) return queue(*c, webSocketFrame(payload), tag, true);
+    if (c->client == client && !c->close_after_write) return queue(*c, webSocketFrame(payload, opcode), tag, true);
+}
+
+std::string WebServer::subprotocol(int client) const {
+  for (const auto& [fd, c] : connections_)
+    if (c->client == client) return c->subprotocol;
+  return "";
 }
 
 void WebServer::writeTo(Connection& c) {

@@ -22,6 +22,7 @@ struct WebServerOptions {
   std::size_t max_queue_frames = 256;       // per client
   std::size_t max_queue_bytes = 8u << 20;   // per client
   std::size_t max_message_bytes = 1u << 16; // a client's text message; larger closes the connection
+  std::vector<std::string> subprotocols;    // WebSocket subprotocols accepted (e.g. foxglove.websocket.v1)
 };
 
 struct WebServerCounters {
@@ -44,8 +45,11 @@ class WebServer {
 
   // WebSocket clients connected now, by id (ids are never reused).
   std::vector<int> clients() const;
-  // Queues a binary frame for a client; `tag` comes back from takeDropped() if the frame is dropped.
-  void send(int client, const std::string& payload, int tag = -1);
+  // Queues a frame (binary, or text with opcode 1) for a client; `tag` comes back from takeDropped() if the
+  // frame is dropped.
+  void send(int client, const std::string& payload, int tag = -1, int opcode = 2);
+  // The subprotocol the client chose among WebServerOptions::subprotocols ("" for none: adit's own page).
+  std::string subprotocol(int client) const;
   // Bytes sent to the client so far (WebSocket frames, headers included), and bytes waiting in its queue.
   std::int64_t bytesSent(int client) const;
   std::size_t queuedBytes(int client) const;

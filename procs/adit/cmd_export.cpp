@@ -1,8 +1,8 @@
-// adit export mcap <log> [<log> ...] -o run.mcap: a run as MCAP with Foxglove schemas (foxglove/mcap_export.hpp),
+// adit export mcap <log> [<log> ...] -o run.mcap: a run as MCAP with Foxglove schemas (foxglove/foxglove_run.hpp),
 // for Foxglove and Lichtblick. Several logs (the sensor log and a replay's output.lcmlog) merge by time.
 #include "commands.hpp"
 
-#include "foxglove/mcap_export.hpp"
+#include "foxglove/mcap_sink.hpp"
 #include "io/atomic_file.hpp"
 #include "view/merged_logs.hpp"
 
@@ -33,7 +33,8 @@ void runExport(const ExportArgs& args) {
   adit::view::DecodeCounts counts;
   adit::io::writeFileAtomically(args.out, [&](std::ostream& out) {
     adit::io::McapWriter writer(out, mcap);
-    adit::foxglove::McapExport exporter(writer, args.options);
+    adit::foxglove::McapSink sink(writer);
+    adit::foxglove::FoxgloveRun exporter(sink, args.options);
     adit::runtime::LogEvent e;
     while (logs.next(e)) {
       ++events;

@@ -3,6 +3,7 @@
 // time slider. The server and the stream: lib/view/. Read-only unless --allow-commands (then save_map only).
 #include "commands.hpp"
 
+#include "foxglove/foxglove_ws.hpp"
 #include "msg/encode.hpp"
 #include "runtime/process.hpp"
 #include "runtime/run_folder.hpp"
@@ -32,12 +33,14 @@ struct ViewArgs {
   bool allow_commands = false;
   double duration_s = 0;
   adit::view::ViewOptions view;
+  bool foxglove = false;
+  int foxglove_sweep_every = 10;
 };
 
 using Clock = std::chrono::steady_clock;
 
-void onMessage(const lcm::ReceiveBuffer* rbuf, const std::string& channel, adit::view::ViewSession* session) {
-  session->apply(channel, static_cast<const std::uint8_t*>(rbuf->data), rbuf->data_size);
+void onMessage(const lcm::ReceiveBuffer* rbuf, const std::string& channel, adit::view::RunConsumer* consumer) {
+  consumer->apply(channel, static_cast<const std::uint8_t*>(rbuf->data), rbuf->data_size, rbuf->recv_utime);
 }
 
 // save_map NAME from the page, only with --allow-commands and only a plain file name (the receiver's rule).
@@ -58,10 +61,11 @@ std::string saveMap(lcm::LCM* lcm, const std::string& text) {
   return "";
 }
 
-void handleCommands(adit::view::WebServer& server, adit::view::ViewSession& session, adit::view::LogPlayer* player,
-                    lcm::LCM* lcm, bool allow_commands) {
+void handleCommands(adit::view::WebServer& server, adit::view::RunConsumer& consumer, adit::view::LogPlayer* player,
+                    adit::foxglove::FoxgloveWs* foxglove, lcm::LCM* lcm, bool allow_commands) {
   for (const auto& [client, text] : server.takeMessages()) {
-    if (player && player->command(text, session)) continue;  // playback of the viewer's own log
+    if (foxglove && foxglove->message(client, text)) continue;  // a Foxglove client's subscriptions
+    if (player && player->command(text, consumer)) continue;   // playback of the viewer's own log
     if (allow_commands && text.rfind("save_map", 0) == 0) {
       const std::string error = saveMap(lcm, text);
       if (error.empty()) {
@@ -83,8 +87,18 @@ void runView(const ViewArgs& a) {
   web.web_root = a.web_root.empty() ? executableDir() + "/../share/adit/view" : a.web_root;
   if (!std::filesystem::exists(web.web_root + "/three.module.js"))
     spdlog::warn("three.js is missing from {} (the build installs it with npm): the page cannot draw", web.web_root);
+  if (a.foxglove) web.subprotocols.push_back(adit::foxglove::kFoxgloveSubprotocol);
   adit::view::WebServer server(web);
   adit::view::ViewSession session(server, a.view);
+  adit::view::Fanout consumers;
+  consumers.add(session);
+  std::unique_ptr<adit::foxglove::FoxgloveWs> foxglove;
+  if (a.foxglove) {
+    adit::foxglove::ExportOptions options;
+    options.sweep_every = a.foxglove_sweep_every;
+    foxglove = std::make_unique<adit::foxglove::FoxgloveWs>(server, options);
+    consumers.add(*foxglove);
+  }
   std::unique_ptr<adit::view::LogPlayer> player;
   std::unique_ptr<lcm::LCM> lcm;
   if (!a.logs.empty()) {
@@ -92,7 +106,7 @@ void runView(const ViewArgs& a) {
   } else {
     lcm = std::make_unique<lcm::LCM>(a.lcm_url);
     if (!lcm->good()) throw std::runtime_error("cannot open LCM '" + a.lcm_url + "'");
-    lcm->subscribeFunction(".*", &onMessage, &session);
+    lcm->subscribeFunction(".*", &onMessage, static_cast<adit::view::RunConsumer*>(&consumers));
   }
   spdlog::info("adit view on http://{}:{}/ ({}{})", a.bind, server.port(),
                player ? fmt::format("{} log(s), {:.1f} s", a.logs.size(), player->duration()) : "live LCM",
@@ -109,8 +123,13 @@ void runView(const ViewArgs& a) {
     const auto now = Clock::now();
     const double dt = std::chrono::duration<double>(now - last).count(), elapsed = std::chrono::duration<double>(now - start).count();
     last = now;
-    if (player) player->advance(dt, session);
-    handleCommands(server, session, player.get(), lcm.get(), a.allow_commands);
+    if (player) player->advance(dt, consumers);
+    for (const int client : server.takeClosed()) {
+      session.forget(client);
+      if (foxglove) foxglove->forget(client);
+    }
+    if (foxglove) foxglove->tick();
+    handleCommands(server, consumers, player.get(), foxglove.get(), lcm.get(), a.allow_commands);
     session.tick(elapsed, player ? player->infoJson() : commands_json);
     if (now - last_report >= std::chrono::seconds(10)) {
       const auto& c = server.counters();
@@ -148,5 +167,10 @@ void registerViewCommand(CLI::App& app) {
   cmd->add_option("--sweep-rate", a->view.sweep_rate_hz, "Sweeps sent per second at most")->check(CLI::Range(0.1, 50.0))->capture_default_str();
   cmd->add_option("--web-root", a->web_root, "Folder of the page (default: <bin>/../share/adit/view)");
   cmd->add_option("--duration", a->duration_s, "Stop after this many seconds (measurements, tests)");
+  cmd->add_flag("--foxglove", a->foxglove,
+                "Also speak the Foxglove WebSocket protocol on the same port (Foxglove / Lichtblick: open ws://HOST:PORT/ws)");
+  cmd->add_option("--foxglove-sweep-every", a->foxglove_sweep_every, "With --foxglove: send every n-th sweep (JSON sweeps are ~0.6 MB)")
+      ->check(CLI::Range(1, 1000))
+      ->capture_default_str();
   cmd->callback([a] { runView(*a); });
 }

@@ -2,7 +2,7 @@
 // loop correction, loops between corrected keyframes, the map's submaps re-placed when a loop moves them,
 // STATUS rows; malformed and unexpected messages counted and skipped. Then the same messages through the
 // export: every topic written, loops and STATUS included.
-#include "foxglove/mcap_export.hpp"
+#include "foxglove/mcap_sink.hpp"
 #include "view/run_decoder.hpp"
 
 #include "core/geometry.hpp"
@@ -184,12 +184,13 @@ TEST(RunModel, TrajectoriesLoopsMapAndStatusFromMessages) {
   EXPECT_EQ(decoder.counts().used, 8);
 }
 
-TEST(McapExport, EveryTopicOfTheRunIsWritten) {
+TEST(FoxgloveRun, EveryTopicOfTheRunIsWrittenToMcap) {
   std::ostringstream out;
   adit::io::McapOptions options;
   options.compression = adit::io::McapCompression::None;
   adit::io::McapWriter writer(out, options);
-  adit::foxglove::McapExport exporter(writer, {});
+  adit::foxglove::McapSink sink(writer);
+  adit::foxglove::FoxgloveRun exporter(sink, {});
   for (const Event& e : sampleRun()) exporter.add(e.channel, e.data.data(), e.data.size(), e.utime);
   exporter.finish();
   writer.finish();
@@ -238,7 +239,9 @@ adit::map_update_t bigUpdate(int first_id, int count, std::int64_t utime) {
 }
 
 TEST(ViewSession, LateJoinerGetsTheMapOnceThenOnlyWhatChanged) {
-  adit::view::WebServer server({"127.0.0.1", 0, "."});
+  adit::view::WebServerOptions options;
+  options.port = 0;
+  adit::view::WebServer server(options);
   adit::view::ViewSession session(server, {});
   const auto feed = [&](const std::string& channel, const std::vector<std::uint8_t>& bytes) {
     session.apply(channel, bytes.data(), bytes.size());

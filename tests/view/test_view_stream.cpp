@@ -168,6 +168,13 @@ class Client {
   int fd_ = -1;
 };
 
+WebServerOptions localOptions(const std::string& root) {
+  WebServerOptions o;
+  o.port = 0;
+  o.web_root = root;
+  return o;
+}
+
 struct WebRoot {
   WebRoot() {
     path = std::filesystem::temp_directory_path() / ("adit_view_test_" + std::to_string(::getpid()));
@@ -180,7 +187,7 @@ struct WebRoot {
 
 TEST(WebServer, ServesItsFolderAnd404sTheRest) {
   WebRoot root;
-  WebServer server({"127.0.0.1", 0, root.path.string()});
+  WebServer server(localOptions(root.path.string()));
   {
     Client c(server.port());
     c.send("GET / HTTP/1.1\r\nHost: x\r\n\r\n");
@@ -200,7 +207,7 @@ TEST(WebServer, ServesItsFolderAnd404sTheRest) {
 
 TEST(WebServer, ASlowClientLosesItsOldestFramesNotTheServer) {
   WebRoot root;
-  WebServerOptions options{"127.0.0.1", 0, root.path.string()};
+  WebServerOptions options = localOptions(root.path.string());
   options.max_queue_frames = 8;
   WebServer server(options);
   Client c(server.port());

@@ -1,7 +1,6 @@
-#include "foxglove/mcap_export.hpp"
+#include "foxglove/foxglove_run.hpp"
 
 #include "foxglove/foxglove_json.hpp"
-#include "foxglove/foxglove_schemas.hpp"
 
 #include <algorithm>
 
@@ -22,24 +21,14 @@ bool due(std::int64_t now, std::int64_t last, double period_s) {
 
 }  // namespace
 
-McapExport::McapExport(io::McapWriter& writer, ExportOptions options) : writer_(writer), options_(options) {}
+FoxgloveRun::FoxgloveRun(FoxgloveSink& sink, ExportOptions options) : sink_(sink), options_(options) {}
 
-void McapExport::publish(const std::string& topic, const std::string& schema, const std::string& json) {
-  auto channel = channels_.find(topic);
-  if (channel == channels_.end()) {
-    auto id = schemas_.find(schema);
-    if (id == schemas_.end()) {
-      const SchemaText text = schemaNamed(schema);
-      id = schemas_.emplace(schema, writer_.addSchema(text.name, "jsonschema", text.json)).first;
-    }
-    channel = channels_.emplace(topic, writer_.addChannel(id->second, topic, "json")).first;
-  }
-  const auto log_ns = static_cast<std::uint64_t>(std::max<std::int64_t>(log_utime_, 0)) * 1000u;
-  writer_.write(channel->second, log_ns, log_ns, json);
+void FoxgloveRun::publish(const std::string& topic, const std::string& schema, const std::string& json) {
+  sink_.publish(topic, schemaNamed(schema), json, static_cast<std::uint64_t>(std::max<std::int64_t>(log_utime_, 0)) * 1000u);
   ++written_[topic];
 }
 
-void McapExport::add(const std::string& channel, const std::uint8_t* data, std::size_t size, std::int64_t log_utime) {
+void FoxgloveRun::add(const std::string& channel, const std::uint8_t* data, std::size_t size, std::int64_t log_utime) {
   log_utime_ = log_utime;
   const unsigned changed = decoder_.apply(channel, data, size, model_);
   if (changed & view::kSweepChanged) {
@@ -73,7 +62,7 @@ void McapExport::add(const std::string& channel, const std::uint8_t* data, std::
     writeMap(log_utime);
 }
 
-void McapExport::writeTrajectories(std::int64_t utime) {
+void FoxgloveRun::writeTrajectories(std::int64_t utime) {
   const double step = options_.trajectory_step_m;
   if (!model_.odometry.empty()) {
     publish("/trajectory/odometry", "foxglove.PosesInFrame",
@@ -88,13 +77,13 @@ void McapExport::writeTrajectories(std::int64_t utime) {
   trajectories_pending_ = false;
 }
 
-void McapExport::writeMap(std::int64_t utime) {
+void FoxgloveRun::writeMap(std::int64_t utime) {
   publish("/map", "foxglove.PointCloud", pointCloudJson(utime, "world", model_.mapPoints(), nullptr));
   last_map_utime_ = utime;
   map_pending_ = false;
 }
 
-void McapExport::finish() {
+void FoxgloveRun::finish() {
   if (trajectories_pending_) writeTrajectories(log_utime_);
   if (map_pending_) writeMap(log_utime_);
 }

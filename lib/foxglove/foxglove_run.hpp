@@ -1,4 +1,5 @@
-// A run's LCM messages as Foxglove channels in an MCAP file (adit export mcap):
+// A run's LCM messages as Foxglove channels, written to a sink (an MCAP file for adit export mcap, the Foxglove
+// WebSocket protocol for adit view --foxglove):
 //   /lidar/points            foxglove.PointCloud      LIDAR_POINTS, frame "lidar" (x, y, z, intensity)
 //   /tf                      foxglove.FrameTransform  world -> lidar (ODOM_MAPPED, as corrected then),
 //                                                     world -> ground_truth (GROUND_TRUTH)
@@ -12,7 +13,7 @@
 // period of log time (and the map at once when a loop moves it, and everything at the end).
 #pragma once
 
-#include "io/mcap_writer.hpp"
+#include "foxglove/foxglove_schemas.hpp"
 #include "view/run_decoder.hpp"
 
 #include <cstdint>
@@ -28,13 +29,21 @@ struct ExportOptions {
   double trajectory_step_m = 0.1;    // poses thinned to this spacing in the trajectory messages
 };
 
-class McapExport {
+// Where the messages go: one JSON message on a topic with its schema, at a log time in nanoseconds.
+class FoxgloveSink {
  public:
-  McapExport(io::McapWriter& writer, ExportOptions options);
+  virtual ~FoxgloveSink() = default;
+  virtual void publish(const std::string& topic, const SchemaText& schema, const std::string& json,
+                       std::uint64_t log_ns) = 0;
+};
 
-  // One LCM event of the run, in log order; log_utime (µs) becomes the MCAP log time.
+class FoxgloveRun {
+ public:
+  FoxgloveRun(FoxgloveSink& sink, ExportOptions options);
+
+  // One LCM event of the run, in log order; log_utime (µs) becomes the messages' log time.
   void add(const std::string& channel, const std::uint8_t* data, std::size_t size, std::int64_t log_utime);
-  // The last trajectories and map. Call once, before McapWriter::finish().
+  // The last trajectories and map (the end of a file).
   void finish();
 
   const view::DecodeCounts& decodeCounts() const { return decoder_.counts(); }
@@ -46,11 +55,10 @@ class McapExport {
   void writeTrajectories(std::int64_t utime);
   void writeMap(std::int64_t utime);
 
-  io::McapWriter& writer_;
+  FoxgloveSink& sink_;
   ExportOptions options_;
   view::RunModel model_;
   view::RunDecoder decoder_;
-  std::map<std::string, std::uint16_t> schemas_, channels_;
   std::map<std::string, std::uint64_t> written_;
   std::int64_t log_utime_ = 0;
   std::int64_t sweeps_seen_ = 0;
