@@ -2,7 +2,7 @@
 # adit export mcap read back by an independent reader: a short simulated run, replayed (MAP_UPDATE recorded),
 # exported with zstd and uncompressed chunks, and each file read by Foxglove's @mcap/core (tests/view/js/
 # read_mcap.js: both of its readers, every CRC, every message against Foxglove's published JSON Schemas).
-# The message counts must be the input logs' counts as `adit info` gives them.
+# The message counts must be the input logs' counts as `adit info` gives them; two exports are byte-identical.
 #   mcap_reader.sh BIN_DIR SOURCE_DIR WORK_DIR
 set -euo pipefail
 bin=$1 src=$2 work=$3
@@ -23,6 +23,9 @@ for compression in zstd none; do
   "$bin"/adit export mcap run.lcmlog out/output.lcmlog -o run-$compression.mcap --compression $compression --chunk-mb 1
   node js/read_mcap.js run-$compression.mcap "/lidar/points=$sweeps" "/tf=$((mapped + truth))" > summary-$compression.json
 done
+# Deterministic: the same logs give the same bytes.
+"$bin"/adit export mcap run.lcmlog out/output.lcmlog -o again.mcap --compression zstd --chunk-mb 1 >/dev/null
+cmp -s run-zstd.mcap again.mcap || { echo "FAIL: two exports of the same logs differ"; exit 1; }
 node -e '
 const s = require(process.argv[1]), plain = require(process.argv[2]);
 const need = (c, m) => { if (!c) { console.error("FAIL: " + m); process.exit(1); } };
