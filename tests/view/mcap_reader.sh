@@ -7,8 +7,8 @@
 set -euo pipefail
 bin=$1 src=$2 work=$3
 source "$src"/tests/view/npm_tools.sh
-npm_tools "$src" "$work"/js
-cd "$work"
+npm_tools "$src" "$work"/../js
+mkdir -p "$work" && cd "$work"
 rm -rf run out ./*.mcap
 "$bin"/adit sim --world roadway-loop --duration 12 --seed 3 -o run.lcmlog --gt gt.tum >/dev/null
 "$bin"/adit replay run.lcmlog -o out --no-progress --record '^(LOOP_CLOSURE|POSE_GRAPH|STATUS_.*|GROUND_TRUTH|MAP_UPDATE)$' >/dev/null
@@ -21,7 +21,7 @@ mapped=$(count out/output.lcmlog ODOM_MAPPED)
 [ "$sweeps" -gt 100 ] && [ "$mapped" -gt 100 ] || { echo "FAIL: the run is too short ($sweeps sweeps, $mapped poses)"; exit 1; }
 for compression in zstd none; do
   "$bin"/adit export mcap run.lcmlog out/output.lcmlog -o run-$compression.mcap --compression $compression --chunk-mb 1
-  node js/read_mcap.js run-$compression.mcap "/lidar/points=$sweeps" "/tf=$((mapped + truth))" > summary-$compression.json
+  node ../js/read_mcap.js run-$compression.mcap "/lidar/points=$sweeps" "/tf=$((mapped + truth))" > summary-$compression.json
 done
 # Deterministic: the same logs give the same bytes.
 "$bin"/adit export mcap run.lcmlog out/output.lcmlog -o again.mcap --compression zstd --chunk-mb 1 >/dev/null

@@ -11,8 +11,8 @@ chromium=${CHROMIUM:-/usr/bin/chromium}
 [ -x "$chromium" ] || { echo "SKIP: no chromium ($chromium; scripts/setup.sh installs Debian's)"; exit 77; }
 [ -f "$bin"/../share/adit/view/three.module.js ] || { echo "SKIP: three.js was not installed into the build (npm unavailable at build time)"; exit 77; }
 source "$src"/tests/view/npm_tools.sh
-npm_tools "$src" "$work"/js
-cd "$work"
+npm_tools "$src" "$work"/../js
+mkdir -p "$work" && cd "$work"
 rm -rf out view.png
 "$bin"/adit sim --world roadway-loop --duration 12 --seed 5 -o run.lcmlog --gt gt.tum >/dev/null
 "$bin"/adit replay run.lcmlog -o out --no-progress --record '^(LOOP_CLOSURE|POSE_GRAPH|GROUND_TRUTH|MAP_UPDATE)$' >/dev/null
@@ -34,7 +34,7 @@ done
 code=$(curl -s -o /dev/null -w '%{http_code}' "http://127.0.0.1:$port/no-such-file.js")
 [ "$code" = 404 ] || { echo "FAIL: unknown path gave HTTP $code"; exit 1; }
 
-node js/view_page.js "http://127.0.0.1:$port/" view.png 90 > state.json
+node ../js/view_page.js "http://127.0.0.1:$port/" view.png 90 > state.json
 node -e '
 const s = require(process.argv[1]), poses = Number(process.argv[2]);
 const need = (c, m) => { if (!c) { console.error("FAIL: " + m + ": " + JSON.stringify(s)); process.exit(1); } };

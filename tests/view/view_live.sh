@@ -11,8 +11,8 @@ chromium=${CHROMIUM:-/usr/bin/chromium}
 [ -x "$chromium" ] || { echo "SKIP: no chromium ($chromium; scripts/setup.sh installs Debian's)"; exit 77; }
 [ -f "$bin"/../share/adit/view/three.module.js ] || { echo "SKIP: three.js was not installed into the build"; exit 77; }
 source "$src"/tests/view/npm_tools.sh
-npm_tools "$src" "$work"/js
-cd "$work"
+npm_tools "$src" "$work"/../js
+mkdir -p "$work" && cd "$work"
 rm -rf runs view.png
 url='udpm://239.255.76.67:7667?ttl=0&recv_buf_size=8388608'
 "$bin"/adit view --lcm-url "$url" --port 0 --allow-commands --duration 120 > view.log 2>&1 &
@@ -28,7 +28,7 @@ for _ in $(seq 50); do
   sleep 0.2
 done
 [ -n "$port" ] || { echo "FAIL: adit view did not start"; cat view.log; exit 1; }
-ADIT_SAVE_MAP=live_test,../escape node js/view_page.js "http://127.0.0.1:$port/" view.png 90 > state.json
+ADIT_SAVE_MAP=live_test,../escape node ../js/view_page.js "http://127.0.0.1:$port/" view.png 90 > state.json
 wait $launch || true
 node -e '
 const s = require(process.argv[1]);
