@@ -3,15 +3,19 @@
 # 30 s) in a private network namespace, adit view --allow-commands listening; Debian's chromium opens the page,
 # which must fill from the live bus (map, trajectory, one STATUS row per process), then asks for save_map twice:
 # "live_test" (published: the loop closer writes live_test.pcd into its run folder) and "../escape" (refused by
-# adit view itself: never published). Run through tests/integration/netns.sh; skipped without chromium or npm.
+# adit view itself: never published). The npm packages are installed first, then the script runs itself again
+# inside a private network namespace (tests/integration/netns.sh); skipped without chromium or npm.
 #   view_live.sh BIN_DIR SOURCE_DIR WORK_DIR
 set -euo pipefail
 bin=$1 src=$2 work=$3
 chromium=${CHROMIUM:-/usr/bin/chromium}
 [ -x "$chromium" ] || { echo "SKIP: no chromium ($chromium; scripts/setup.sh installs Debian's)"; exit 77; }
 [ -f "$bin"/../share/adit/view/three.module.js ] || { echo "SKIP: three.js was not installed into the build"; exit 77; }
-source "$src"/tests/view/npm_tools.sh
-npm_tools "$src" "$work"/../js
+if [ -z "${ADIT_IN_NETNS:-}" ]; then
+  source "$src"/tests/view/npm_tools.sh
+  npm_tools "$src" "$work"/../js  # with the network; the namespace has none
+  exec "$src"/tests/integration/netns.sh "$0" "$@"
+fi
 mkdir -p "$work" && cd "$work"
 rm -rf runs view.png
 url='udpm://239.255.76.67:7667?ttl=0&recv_buf_size=8388608'
