@@ -54,7 +54,7 @@ void FoxgloveRun::add(const std::string& channel, const std::uint8_t* data, std:
   }
   if (changed & view::kStatusChanged) {
     const view::StatusRow& row = model_.status.at(model_.newest_status);
-    publish("/status/" + row.process, "adit.Status", statusJson(row));
+    publish("/status/" + (row.process.empty() ? std::string("unnamed") : row.process), "adit.Status", statusJson(row));
   }
   if (changed & (view::kSubmapsAdded | view::kSubmapsMoved)) map_pending_ = true;
   if (trajectories_pending_ && due(log_utime, last_trajectory_utime_, options_.trajectory_period_s)) writeTrajectories(log_utime);

@@ -180,7 +180,9 @@ bool decodeFrame(const std::string& bytes, DecodedFrame& f) {
       break;
     }
     case FrameType::Trajectory: {
-      f.kind = static_cast<TrajectoryKind>(in.get<std::uint8_t>());
+      const auto kind = in.get<std::uint8_t>();
+      if (kind > static_cast<std::uint8_t>(TrajectoryKind::Keyframes)) return false;
+      f.kind = static_cast<TrajectoryKind>(kind);
       f.replace = in.get<std::uint8_t>() != 0;
       const auto n = in.count(12);
       for (std::uint32_t i = 0; i < n; ++i) {

@@ -119,6 +119,9 @@ TEST(ViewStream, TruncatedOrUnknownFramesAreRefused) {
   for (std::size_t n = 0; n < whole.size(); ++n) EXPECT_FALSE(decodeFrame(whole.substr(0, n), f)) << n;
   EXPECT_FALSE(decodeFrame(whole + "x", f));
   EXPECT_FALSE(decodeFrame(std::string(1, '\x63'), f));
+  std::string unknown_kind = encodeTrajectory(TrajectoryKind::Odometry, true, {}, 0);
+  unknown_kind[1] = 9;
+  EXPECT_FALSE(decodeFrame(unknown_kind, f));
 }
 
 TEST(Base64, Rfc4648Vectors) {
