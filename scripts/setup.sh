@@ -14,8 +14,9 @@ PACKAGES=(
   libgtest-dev libgmock-dev libbenchmark-dev
   openjdk-17-jdk-headless openjdk-17-jre libjchart2d-java
   python3-numpy python3-matplotlib
-  libssl-dev libbz2-dev liblz4-dev
+  libssl-dev libbz2-dev liblz4-dev libzstd-dev
   iproute2 util-linux nftables
+  nodejs npm chromium
 )
 
 missing=()

@@ -3,7 +3,6 @@
 #include "core/byte_codec.hpp"
 #include "io/atomic_file.hpp"
 
-#include <array>
 #include <cstring>
 #include <fstream>
 #include <iterator>
@@ -15,24 +14,7 @@ constexpr char kMagic[8] = {'A', 'D', 'I', 'T', 'C', 'K', 'P', 'T'};
 // A checkpoint holds at most the loop closer's keyframes (~60 kB each at 0.2 m): 2 GB is far beyond any run.
 constexpr std::uintmax_t kMaxCheckpointBytes = 2ull << 30;
 
-std::array<std::uint32_t, 256> crcTable() {
-  std::array<std::uint32_t, 256> table{};
-  for (std::uint32_t i = 0; i < 256; ++i) {
-    std::uint32_t c = i;
-    for (int k = 0; k < 8; ++k) c = (c & 1u) ? 0xEDB88320u ^ (c >> 1) : c >> 1;
-    table[i] = c;
-  }
-  return table;
-}
-
 }  // namespace
-
-std::uint32_t crc32(const char* data, std::size_t size) {
-  static const std::array<std::uint32_t, 256> table = crcTable();
-  std::uint32_t c = 0xFFFFFFFFu;
-  for (std::size_t i = 0; i < size; ++i) c = table[(c ^ static_cast<std::uint8_t>(data[i])) & 0xFFu] ^ (c >> 8);
-  return c ^ 0xFFFFFFFFu;
-}
 
 void saveCheckpoint(const std::string& path, const std::string& kind, const std::string& run_id,
                     const std::string& payload) {

@@ -9,6 +9,8 @@
 //   u32         CRC-32 of everything before it
 #pragma once
 
+#include "core/crc32.hpp"
+
 #include <cstdint>
 #include <string>
 
@@ -30,6 +32,6 @@ struct LoadedCheckpoint {
 // Never throws.
 LoadedCheckpoint loadCheckpoint(const std::string& path, const std::string& kind, const std::string& run_id);
 
-std::uint32_t crc32(const char* data, std::size_t size);
+using adit::crc32;  // core/crc32.hpp: the checkpoints' and record logs' checksum
 
 }  // namespace adit::runtime

@@ -14,6 +14,8 @@ void registerLaunchCommand(CLI::App& app);
 void registerSpyCommand(CLI::App& app);
 void registerEvalCommand(CLI::App& app);
 void registerCommandCommand(CLI::App& app);
+void registerExportCommand(CLI::App& app);
+void registerViewCommand(CLI::App& app);
 
 void registerDemoCommand(CLI::App& app);
 void registerBenchCommand(CLI::App& app);

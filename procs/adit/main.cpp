@@ -41,6 +41,8 @@ int main(int argc, char** argv) {
   registerSpyCommand(app);
   registerEvalCommand(app);
   registerCommandCommand(app);
+  registerExportCommand(app);
+  registerViewCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

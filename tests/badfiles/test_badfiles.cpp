@@ -204,6 +204,11 @@ TEST_F(BadFiles, EveryReaderFailsCleanly) {
                        return bin("adit") + " replay " + (d / "in.lcmlog").string() + " -o " + (d / "out").string() +
                               " --stages feature --no-progress|in.lcmlog";
                      }, damaged_but_readable ? std::vector<std::string>{} : std::vector<std::string>{"out/output.lcmlog"}});
+    cases.push_back({"LCM log (export mcap)", what, [bytes = bytes](const fs::path& d) {
+                       spit(d / "in.lcmlog", bytes);
+                       return bin("adit") + " export mcap " + (d / "in.lcmlog").string() + " -o " +
+                              (d / "out.mcap").string() + "|in.lcmlog";
+                     }, damaged_but_readable ? std::vector<std::string>{} : std::vector<std::string>{"out.mcap"}});
   }
   // adit eval on a bad estimate.
   const std::string tum = "0.0 0 0 0 0 0 0 1\n0.1 1 0 0 0 0 0 1\n0.2 2 0 0 0 0 0 1\n";
