@@ -72,13 +72,14 @@ Correspondences ScanToMapMapper::match(const std::vector<Eigen::Vector3d>& corne
                                        const std::vector<Eigen::Vector3d>& surfs, const Eigen::Isometry3d& T) const {
   Correspondences m;
   const int k = std::max(3, config_.neighbours);
+  std::vector<Eigen::Vector3d> near;
   for (const Eigen::Vector3d& p : corners) {
-    const auto near = corner_map_.nearest(T * p, k, config_.max_neighbour_distance_m);
+    corner_map_.nearest(T * p, k, config_.max_neighbour_distance_m, near);
     if (static_cast<int>(near.size()) < k) continue;
     if (const auto line = fitLine(near, config_.line_eigen_ratio)) m.lines.push_back({p, line->centroid, line->direction});
   }
   for (const Eigen::Vector3d& p : surfs) {
-    const auto near = surf_map_.nearest(T * p, k, config_.max_neighbour_distance_m);
+    surf_map_.nearest(T * p, k, config_.max_neighbour_distance_m, near);
     if (static_cast<int>(near.size()) < k) continue;
     if (const auto plane = fitPlane(near, config_.plane_max_point_distance_m))
       m.planes.push_back({p, plane->normal, plane->offset});
