@@ -3,6 +3,7 @@
 #include "registration/feature_fit.hpp"
 #include "odometry/motion_compensation.hpp"
 #include "odometry/startup_search.hpp"
+#include "registration/parallel_matching.hpp"
 #include "registration/pose_increment.hpp"
 
 #include <algorithm>
@@ -79,7 +80,10 @@ ScanToScanConfig scanToScanConfigFrom(const Config& c) {
   return scanToScanConfigTable().read(c, aloam ? aloamOdometryConfig() : ScanToScanConfig{});
 }
 
-ScanToScanOdometry::ScanToScanOdometry(ScanToScanConfig config) : config_(std::move(config)) {}
+ScanToScanOdometry::ScanToScanOdometry(ScanToScanConfig config)
+    : config_(std::move(config)),
+      pool_(config_.registration.search_threads > 1 ? std::make_shared<ChunkPool>(config_.registration.search_threads)
+                                                    : nullptr) {}
 
 void ScanToScanOdometry::reset() { *this = ScanToScanOdometry(config_); }
 
@@ -190,19 +194,18 @@ std::optional<PlaneFit> ScanToScanOdometry::fitLocalPlane(const Eigen::Vector3d&
 
 Correspondences ScanToScanOdometry::match(const std::vector<LidarPoint>& sharp, const std::vector<LidarPoint>& flat,
                                           const Eigen::Isometry3d& T) const {
-  Correspondences m;
   const double max_sq = config_.max_match_distance_m * config_.max_match_distance_m;
-  for (const LidarPoint& lp : sharp) {
-    if (!lp.p.allFinite()) continue;
-    const Eigen::Vector3d p = lp.p.cast<double>(), q = T * p;
-    if (const auto line = fitLocalLine(q, max_sq)) m.lines.push_back({p, line->centroid, line->direction});
-  }
-  for (const LidarPoint& lp : flat) {
-    if (!lp.p.allFinite()) continue;
-    const Eigen::Vector3d p = lp.p.cast<double>(), q = T * p;
-    if (const auto plane = fitLocalPlane(q, max_sq)) m.planes.push_back({p, plane->normal, plane->offset});
-  }
-  return m;
+  const auto add_line = [&](std::size_t i, std::vector<LineMatch>& lines) {
+    if (!sharp[i].p.allFinite()) return;
+    const Eigen::Vector3d p = sharp[i].p.cast<double>(), q = T * p;
+    if (const auto line = fitLocalLine(q, max_sq)) lines.push_back({p, line->centroid, line->direction});
+  };
+  const auto add_plane = [&](std::size_t i, std::vector<PlaneMatch>& planes) {
+    if (!flat[i].p.allFinite()) return;
+    const Eigen::Vector3d p = flat[i].p.cast<double>(), q = T * p;
+    if (const auto plane = fitLocalPlane(q, max_sq)) planes.push_back({p, plane->normal, plane->offset});
+  };
+  return matchInChunks(pool_.get(), sharp.size(), flat.size(), add_line, add_plane);
 }
 
 ScanToScanOdometry::Refinement ScanToScanOdometry::refine(const SweepPoints& cur, const Eigen::Isometry3d& seed,

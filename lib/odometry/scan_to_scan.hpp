@@ -12,9 +12,12 @@
 #include "registration/solver.hpp"
 #include "odometry/ring_cloud.hpp"
 
+#include <memory>
 #include <optional>
 
 namespace adit {
+
+class ChunkPool;  // registration/chunk_pool.hpp
 
 struct ScanToScanConfig {
   RegistrationConfig registration;  // keys "odometry.<field>" (see registration.hpp)
@@ -150,6 +153,7 @@ class ScanToScanOdometry {
   std::optional<PlaneFit> fitLocalPlane(const Eigen::Vector3d& q, double max_sq) const;
 
   ScanToScanConfig config_;
+  std::shared_ptr<ChunkPool> pool_;  // correspondence search threads (none: search_threads 1)
   RingIndexedCloud prev_corners_;  // previous corner_less_sharp, previous lidar frame
   RingIndexedCloud prev_surfs_;    // previous surf_less_flat
   SweepPoints prev_points_;        // the previous sweep's features, kept to compensate them if they were raw
