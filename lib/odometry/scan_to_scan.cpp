@@ -131,7 +131,8 @@ std::optional<LineFit> ScanToScanOdometry::fitLocalLine(const Eigen::Vector3d& q
   const int j = prev_corners_.nearest(q, max_sq);
   if (j < 0) return std::nullopt;
   const int ring = prev_corners_.ring(j);
-  std::vector<Eigen::Vector3d> pts{prev_corners_.point(j)};
+  thread_local std::vector<Eigen::Vector3d> pts;  // scratch, reused: no allocation per query
+  pts.assign(1, prev_corners_.point(j));
   for (int r = ring - config_.ring_window; r <= ring + config_.ring_window; ++r) {
     if (r == ring) continue;
     const int k = prev_corners_.nearestInRing(r, q, max_sq, -1);
@@ -174,15 +175,19 @@ std::optional<PlaneFit> ScanToScanOdometry::fitLocalPlane(const Eigen::Vector3d&
   // a sparse sweep's nearest points often lie on one ring (collinear, so the plane's tilt about that line
   // would be noise). A-LOAM takes a single point from the neighbouring ring, which near a wall-floor junction
   // is often on the other face; several points per ring and the outlier check of fitPlane reject that.
-  std::vector<int> near = prev_surfs_.nearestK(q, config_.plane_neighbours, max_sq);
+  // Scratch buffers, reused (this runs on several threads at once: one set per thread).
+  thread_local std::vector<int> near, in_ring;
+  thread_local std::vector<Eigen::Vector3d> pts;
+  prev_surfs_.nearestK(q, config_.plane_neighbours, max_sq, near);
   if (near.empty()) return std::nullopt;
   const int ring = prev_surfs_.ring(near.front());
   for (int r = ring - config_.ring_window; r <= ring + config_.ring_window; ++r) {
     if (r == ring) continue;
-    for (int i : prev_surfs_.nearestKInRing(r, q, config_.ring_neighbours, max_sq))
+    prev_surfs_.nearestKInRing(r, q, config_.ring_neighbours, max_sq, in_ring);
+    for (int i : in_ring)
       if (std::find(near.begin(), near.end(), i) == near.end()) near.push_back(i);
   }
-  std::vector<Eigen::Vector3d> pts;
+  pts.clear();
   bool several_rings = false;
   for (int i : near) {
     pts.push_back(prev_surfs_.point(i));
