@@ -96,7 +96,7 @@ ScanToMapMapper::Sweep ScanToMapMapper::prepare(const FeatureSet& f) const {
   s.raw = !f.cloud.deskewed;
   s.corners = f.corner_less_sharp;
   s.surfs = f.surf_less_flat;
-  s.cloud = f.cloud.points;
+  if (keep_global_map_) s.cloud = f.cloud.points;  // only the global map takes the whole cloud
   downsample(s);
   return s;
 }
