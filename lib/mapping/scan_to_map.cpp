@@ -3,6 +3,7 @@
 #include "mapping/downsample.hpp"
 #include "registration/feature_fit.hpp"
 #include "odometry/motion_compensation.hpp"
+#include "registration/parallel_matching.hpp"
 #include "registration/pose_increment.hpp"
 #include "odometry/scan_to_scan.hpp"
 
@@ -66,24 +67,27 @@ ScanToMapMapper::ScanToMapMapper(MapperConfig config)
     : config_(std::move(config)),
       corner_map_(config_.map_voxel_size_m, config_.corner_resolution_m, config_.max_points_per_voxel),
       surf_map_(config_.map_voxel_size_m, config_.surf_resolution_m, config_.max_points_per_voxel),
-      global_map_(config_.global_map_resolution_m, static_cast<std::size_t>(config_.global_map_max_voxels)) {}
+      global_map_(config_.global_map_resolution_m, static_cast<std::size_t>(config_.global_map_max_voxels)),
+      pool_(config_.registration.search_threads > 1 ? std::make_shared<ChunkPool>(config_.registration.search_threads)
+                                                    : nullptr) {}
 
 Correspondences ScanToMapMapper::match(const std::vector<Eigen::Vector3d>& corners,
                                        const std::vector<Eigen::Vector3d>& surfs, const Eigen::Isometry3d& T) const {
-  Correspondences m;
   const int k = std::max(3, config_.neighbours);
-  for (const Eigen::Vector3d& p : corners) {
-    const auto near = corner_map_.nearest(T * p, k, config_.max_neighbour_distance_m);
-    if (static_cast<int>(near.size()) < k) continue;
-    if (const auto line = fitLine(near, config_.line_eigen_ratio)) m.lines.push_back({p, line->centroid, line->direction});
-  }
-  for (const Eigen::Vector3d& p : surfs) {
-    const auto near = surf_map_.nearest(T * p, k, config_.max_neighbour_distance_m);
-    if (static_cast<int>(near.size()) < k) continue;
+  const auto add_line = [&](std::size_t i, std::vector<LineMatch>& lines) {
+    thread_local std::vector<Eigen::Vector3d> near;
+    corner_map_.nearest(T * corners[i], k, config_.max_neighbour_distance_m, near);
+    if (static_cast<int>(near.size()) < k) return;
+    if (const auto line = fitLine(near, config_.line_eigen_ratio)) lines.push_back({corners[i], line->centroid, line->direction});
+  };
+  const auto add_plane = [&](std::size_t i, std::vector<PlaneMatch>& planes) {
+    thread_local std::vector<Eigen::Vector3d> near;
+    surf_map_.nearest(T * surfs[i], k, config_.max_neighbour_distance_m, near);
+    if (static_cast<int>(near.size()) < k) return;
     if (const auto plane = fitPlane(near, config_.plane_max_point_distance_m))
-      m.planes.push_back({p, plane->normal, plane->offset});
-  }
-  return m;
+      planes.push_back({surfs[i], plane->normal, plane->offset});
+  };
+  return matchInChunks(pool_.get(), corners.size(), surfs.size(), add_line, add_plane);
 }
 
 ScanToMapMapper::Sweep ScanToMapMapper::prepare(const FeatureSet& f) const {
@@ -92,7 +96,7 @@ ScanToMapMapper::Sweep ScanToMapMapper::prepare(const FeatureSet& f) const {
   s.raw = !f.cloud.deskewed;
   s.corners = f.corner_less_sharp;
   s.surfs = f.surf_less_flat;
-  s.cloud = f.cloud.points;
+  if (keep_global_map_) s.cloud = f.cloud.points;  // only the global map takes the whole cloud
   downsample(s);
   return s;
 }

@@ -11,9 +11,12 @@
 #include "registration/correspondences.hpp"
 #include "registration/solver.hpp"
 
+#include <memory>
 #include <optional>
 
 namespace adit {
+
+class ChunkPool;  // registration/chunk_pool.hpp
 
 struct MapperConfig {
   RegistrationConfig registration;  // keys "mapping.<field>" (see registration.hpp)
@@ -122,6 +125,7 @@ class ScanToMapMapper {
   VoxelMap corner_map_;
   VoxelMap surf_map_;
   GlobalMap global_map_;
+  std::shared_ptr<ChunkPool> pool_;  // correspondence search threads (none: search_threads 1)
   bool keep_global_map_ = true;
   Eigen::Isometry3d T_map_odom_ = Eigen::Isometry3d::Identity();  // drift correction of the odometry
   bool corrected_ = false;  // a correction arrived since the last output (flag it once)

@@ -46,7 +46,14 @@ void VoxelMap::transform(const Eigen::Isometry3d& T) {
 }
 
 std::vector<Eigen::Vector3d> VoxelMap::nearest(const Eigen::Vector3d& q, int k, double max_distance) const {
-  if (k <= 0 || !q.allFinite()) return {};
+  std::vector<Eigen::Vector3d> out;
+  nearest(q, k, max_distance, out);
+  return out;
+}
+
+void VoxelMap::nearest(const Eigen::Vector3d& q, int k, double max_distance, std::vector<Eigen::Vector3d>& out) const {
+  out.clear();
+  if (k <= 0 || !q.allFinite()) return;
   // The k best so far, ascending (a fixed buffer: no allocation while searching).
   constexpr int kStack = 32;
   std::pair<double, const Eigen::Vector3d*> stack[kStack];
@@ -65,11 +72,18 @@ std::vector<Eigen::Vector3d> VoxelMap::nearest(const Eigen::Vector3d& q, int k, 
   const Eigen::Vector3d lo = q - Eigen::Vector3d(c.x, c.y, c.z) * voxel_size_;
   const Eigen::Vector3d hi = Eigen::Vector3d::Constant(voxel_size_) - lo;
   const auto face_sq = [&](int axis, int d) { return d == 0 ? 0.0 : (d < 0 ? lo[axis] * lo[axis] : hi[axis] * hi[axis]); };
-  // The query's own voxel first (it holds the nearest points most often), then its neighbours.
-  static constexpr int kOrder[3] = {0, -1, 1};
-  for (int dx : kOrder)
-    for (int dy : kOrder)
-      for (int dz : kOrder) {
+  // The query's own voxel first (it holds the nearest points most often), then per axis the neighbour across
+  // the nearer face before the one across the farther face: the k-th best shrinks early and prunes more.
+  int order[3][3];
+  for (int axis = 0; axis < 3; ++axis) {
+    const int nearer = lo[axis] <= hi[axis] ? -1 : 1;
+    order[axis][0] = 0;
+    order[axis][1] = nearer;
+    order[axis][2] = -nearer;
+  }
+  for (int dx : order[0])
+    for (int dy : order[1])
+      for (int dz : order[2]) {
         if (face_sq(0, dx) + face_sq(1, dy) + face_sq(2, dz) >= bound()) continue;
         const auto it = voxels_.find({c.x + dx, c.y + dy, c.z + dz});
         if (it == voxels_.end()) continue;
@@ -83,10 +97,7 @@ std::vector<Eigen::Vector3d> VoxelMap::nearest(const Eigen::Vector3d& q, int k, 
           count = std::min(count + 1, k);
         }
       }
-  std::vector<Eigen::Vector3d> out;
-  out.reserve(static_cast<std::size_t>(count));
   for (int i = 0; i < count; ++i) out.push_back(*best[i].second);
-  return out;
 }
 
 std::vector<Eigen::Vector3d> VoxelMap::points() const {

@@ -29,6 +29,8 @@ class VoxelMap {
 
   // Up to k nearest points within max_distance (<= voxel size for exactness), nearest first.
   std::vector<Eigen::Vector3d> nearest(const Eigen::Vector3d& q, int k, double max_distance) const;
+  // The same into `out` (its capacity is reused: no allocation per query in a loop).
+  void nearest(const Eigen::Vector3d& q, int k, double max_distance, std::vector<Eigen::Vector3d>& out) const;
 
   std::vector<Eigen::Vector3d> points() const;  // sorted by voxel key
   std::size_t numPoints() const { return num_points_; }

@@ -35,13 +35,13 @@ int RingIndexedCloud::nearestInRing(int ring, const Eigen::Vector3d& q, double m
   return local < 0 ? -1 : r.to_global[static_cast<std::size_t>(local)];
 }
 
-std::vector<int> RingIndexedCloud::nearestKInRing(int ring, const Eigen::Vector3d& q, int k,
-                                                 double max_sq_distance) const {
+void RingIndexedCloud::nearestKInRing(int ring, const Eigen::Vector3d& q, int k, double max_sq_distance,
+                                      std::vector<int>& out) const {
+  out.clear();
   const auto it = by_ring_.find(ring);
-  if (it == by_ring_.end()) return {};
-  std::vector<int> out = it->second.tree.nearestK(q, k, max_sq_distance);
+  if (it == by_ring_.end()) return;
+  it->second.tree.nearestK(q, k, max_sq_distance, out);
   for (int& i : out) i = it->second.to_global[static_cast<std::size_t>(i)];
-  return out;
 }
 
 int RingIndexedCloud::nearestInNeighbourRings(int ring, int window, const Eigen::Vector3d& q,

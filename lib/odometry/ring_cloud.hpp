@@ -18,12 +18,21 @@ class RingIndexedCloud {
 
   // Indices below refer to point(i) / ring(i); -1 means none within sqrt(max_sq_distance).
   int nearest(const Eigen::Vector3d& q, double max_sq_distance) const;
+  // The k-nearest queries write into `out` (its capacity is reused: no allocation per query in a loop).
+  void nearestK(const Eigen::Vector3d& q, int k, double max_sq_distance, std::vector<int>& out) const {
+    all_.nearestK(q, k, max_sq_distance, out);
+  }
   std::vector<int> nearestK(const Eigen::Vector3d& q, int k, double max_sq_distance) const {
     return all_.nearestK(q, k, max_sq_distance);
   }
   int nearestInRing(int ring, const Eigen::Vector3d& q, double max_sq_distance, int exclude) const;
   // Up to k nearest points of one ring, nearest first.
-  std::vector<int> nearestKInRing(int ring, const Eigen::Vector3d& q, int k, double max_sq_distance) const;
+  void nearestKInRing(int ring, const Eigen::Vector3d& q, int k, double max_sq_distance, std::vector<int>& out) const;
+  std::vector<int> nearestKInRing(int ring, const Eigen::Vector3d& q, int k, double max_sq_distance) const {
+    std::vector<int> out;
+    nearestKInRing(ring, q, k, max_sq_distance, out);
+    return out;
+  }
   // Nearest over rings ring-window .. ring+window, excluding `ring` itself.
   int nearestInNeighbourRings(int ring, int window, const Eigen::Vector3d& q, double max_sq_distance) const;
 

@@ -3,6 +3,7 @@
 #include "registration/feature_fit.hpp"
 #include "odometry/motion_compensation.hpp"
 #include "odometry/startup_search.hpp"
+#include "registration/parallel_matching.hpp"
 #include "registration/pose_increment.hpp"
 
 #include <algorithm>
@@ -79,7 +80,10 @@ ScanToScanConfig scanToScanConfigFrom(const Config& c) {
   return scanToScanConfigTable().read(c, aloam ? aloamOdometryConfig() : ScanToScanConfig{});
 }
 
-ScanToScanOdometry::ScanToScanOdometry(ScanToScanConfig config) : config_(std::move(config)) {}
+ScanToScanOdometry::ScanToScanOdometry(ScanToScanConfig config)
+    : config_(std::move(config)),
+      pool_(config_.registration.search_threads > 1 ? std::make_shared<ChunkPool>(config_.registration.search_threads)
+                                                    : nullptr) {}
 
 void ScanToScanOdometry::reset() { *this = ScanToScanOdometry(config_); }
 
@@ -124,14 +128,15 @@ std::optional<LineFit> ScanToScanOdometry::fitLocalLine(const Eigen::Vector3d& q
   // The nearest previous edge point and the nearest on each ring within ring_window of it: one point per
   // ring, so the line follows the edge across rings. With line_min_rings = 2 the line runs through the
   // nearest point and the nearest point on another ring (A-LOAM); more rings must also be collinear.
-  const int j = prev_corners_.nearest(q, max_sq);
+  const int j = previous_->corners.nearest(q, max_sq);
   if (j < 0) return std::nullopt;
-  const int ring = prev_corners_.ring(j);
-  std::vector<Eigen::Vector3d> pts{prev_corners_.point(j)};
+  const int ring = previous_->corners.ring(j);
+  thread_local std::vector<Eigen::Vector3d> pts;  // scratch, reused: no allocation per query
+  pts.assign(1, previous_->corners.point(j));
   for (int r = ring - config_.ring_window; r <= ring + config_.ring_window; ++r) {
     if (r == ring) continue;
-    const int k = prev_corners_.nearestInRing(r, q, max_sq, -1);
-    if (k >= 0) pts.push_back(prev_corners_.point(k));
+    const int k = previous_->corners.nearestInRing(r, q, max_sq, -1);
+    if (k >= 0) pts.push_back(previous_->corners.point(k));
   }
   if (static_cast<int>(pts.size()) < std::max(2, config_.line_min_rings)) return std::nullopt;
   if (config_.line_min_rings <= 2) {  // A-LOAM's two-point line: the nearest and the closest other-ring point
@@ -152,13 +157,13 @@ std::optional<LineFit> ScanToScanOdometry::fitLocalLine(const Eigen::Vector3d& q
 }
 
 std::optional<PlaneFit> ScanToScanOdometry::threePointPlane(const Eigen::Vector3d& q, double max_sq) const {
-  const int j = prev_surfs_.nearest(q, max_sq);
+  const int j = previous_->surfs.nearest(q, max_sq);
   if (j < 0) return std::nullopt;
-  const int ring = prev_surfs_.ring(j);
-  const int l = prev_surfs_.nearestInRing(ring, q, max_sq, j);
-  const int k = prev_surfs_.nearestInNeighbourRings(ring, config_.ring_window, q, max_sq);
+  const int ring = previous_->surfs.ring(j);
+  const int l = previous_->surfs.nearestInRing(ring, q, max_sq, j);
+  const int k = previous_->surfs.nearestInNeighbourRings(ring, config_.ring_window, q, max_sq);
   if (l < 0 || k < 0) return std::nullopt;
-  const Eigen::Vector3d a = prev_surfs_.point(j), b = prev_surfs_.point(l), c = prev_surfs_.point(k);
+  const Eigen::Vector3d a = previous_->surfs.point(j), b = previous_->surfs.point(l), c = previous_->surfs.point(k);
   const Eigen::Vector3d n = (b - a).cross(c - a);
   if (n.norm() < 1e-9) return std::nullopt;
   return PlaneFit{n.normalized(), -n.normalized().dot(a)};
@@ -170,19 +175,23 @@ std::optional<PlaneFit> ScanToScanOdometry::fitLocalPlane(const Eigen::Vector3d&
   // a sparse sweep's nearest points often lie on one ring (collinear, so the plane's tilt about that line
   // would be noise). A-LOAM takes a single point from the neighbouring ring, which near a wall-floor junction
   // is often on the other face; several points per ring and the outlier check of fitPlane reject that.
-  std::vector<int> near = prev_surfs_.nearestK(q, config_.plane_neighbours, max_sq);
+  // Scratch buffers, reused (this runs on several threads at once: one set per thread).
+  thread_local std::vector<int> near, in_ring;
+  thread_local std::vector<Eigen::Vector3d> pts;
+  previous_->surfs.nearestK(q, config_.plane_neighbours, max_sq, near);
   if (near.empty()) return std::nullopt;
-  const int ring = prev_surfs_.ring(near.front());
+  const int ring = previous_->surfs.ring(near.front());
   for (int r = ring - config_.ring_window; r <= ring + config_.ring_window; ++r) {
     if (r == ring) continue;
-    for (int i : prev_surfs_.nearestKInRing(r, q, config_.ring_neighbours, max_sq))
+    previous_->surfs.nearestKInRing(r, q, config_.ring_neighbours, max_sq, in_ring);
+    for (int i : in_ring)
       if (std::find(near.begin(), near.end(), i) == near.end()) near.push_back(i);
   }
-  std::vector<Eigen::Vector3d> pts;
+  pts.clear();
   bool several_rings = false;
   for (int i : near) {
-    pts.push_back(prev_surfs_.point(i));
-    several_rings = several_rings || prev_surfs_.ring(i) != ring;
+    pts.push_back(previous_->surfs.point(i));
+    several_rings = several_rings || previous_->surfs.ring(i) != ring;
   }
   if (!several_rings) return std::nullopt;
   return fitPlane(pts, config_.plane_max_point_distance_m);
@@ -190,19 +199,19 @@ std::optional<PlaneFit> ScanToScanOdometry::fitLocalPlane(const Eigen::Vector3d&
 
 Correspondences ScanToScanOdometry::match(const std::vector<LidarPoint>& sharp, const std::vector<LidarPoint>& flat,
                                           const Eigen::Isometry3d& T) const {
-  Correspondences m;
+  awaitPrevious();
   const double max_sq = config_.max_match_distance_m * config_.max_match_distance_m;
-  for (const LidarPoint& lp : sharp) {
-    if (!lp.p.allFinite()) continue;
-    const Eigen::Vector3d p = lp.p.cast<double>(), q = T * p;
-    if (const auto line = fitLocalLine(q, max_sq)) m.lines.push_back({p, line->centroid, line->direction});
-  }
-  for (const LidarPoint& lp : flat) {
-    if (!lp.p.allFinite()) continue;
-    const Eigen::Vector3d p = lp.p.cast<double>(), q = T * p;
-    if (const auto plane = fitLocalPlane(q, max_sq)) m.planes.push_back({p, plane->normal, plane->offset});
-  }
-  return m;
+  const auto add_line = [&](std::size_t i, std::vector<LineMatch>& lines) {
+    if (!sharp[i].p.allFinite()) return;
+    const Eigen::Vector3d p = sharp[i].p.cast<double>(), q = T * p;
+    if (const auto line = fitLocalLine(q, max_sq)) lines.push_back({p, line->centroid, line->direction});
+  };
+  const auto add_plane = [&](std::size_t i, std::vector<PlaneMatch>& planes) {
+    if (!flat[i].p.allFinite()) return;
+    const Eigen::Vector3d p = flat[i].p.cast<double>(), q = T * p;
+    if (const auto plane = fitLocalPlane(q, max_sq)) planes.push_back({p, plane->normal, plane->offset});
+  };
+  return matchInChunks(pool_.get(), sharp.size(), flat.size(), add_line, add_plane);
 }
 
 ScanToScanOdometry::Refinement ScanToScanOdometry::refine(const SweepPoints& cur, const Eigen::Isometry3d& seed,
@@ -241,10 +250,24 @@ ScanToScanOdometry::Refinement ScanToScanOdometry::searchStart(const SweepPoints
   return best;
 }
 
-void ScanToScanOdometry::setPrevious(const SweepPoints& points) {
+void ScanToScanOdometry::setPrevious(const SweepPoints& points, bool in_background) {
   prev_points_ = points;
-  prev_corners_ = RingIndexedCloud(points.less_sharp);
-  prev_surfs_ = RingIndexedCloud(points.less_flat);
+  building_previous_ = {};  // a build still running is waited for (its future's last owner) and dropped
+  const auto build = [](std::vector<LidarPoint> less_sharp, std::vector<LidarPoint> less_flat) {
+    return std::shared_ptr<const PreviousIndex>(
+        new PreviousIndex{RingIndexedCloud(less_sharp), RingIndexedCloud(less_flat)});
+  };
+  if (in_background && pool_) {
+    building_previous_ = std::async(std::launch::async, build, points.less_sharp, points.less_flat).share();
+  } else {
+    previous_ = build(points.less_sharp, points.less_flat);
+  }
+}
+
+void ScanToScanOdometry::awaitPrevious() const {
+  if (!building_previous_.valid()) return;
+  previous_ = building_previous_.get();
+  building_previous_ = {};
 }
 
 PoseEstimate ScanToScanOdometry::process(const FeatureSet& f, const std::optional<Eigen::Isometry3d>& prior,
@@ -317,7 +340,7 @@ PoseEstimate ScanToScanOdometry::process(const FeatureSet& f, const std::optiona
   }
   out.pose = pose_;
   // A compensated raw sweep counts as deskewed from now on.
-  setPrevious(cur);
+  setPrevious(cur, true);
   previous_raw_ = cur_raw && !mixed;
   has_previous_ = true;
   previous_utime_ = f.utime;

@@ -12,9 +12,13 @@
 #include "registration/solver.hpp"
 #include "odometry/ring_cloud.hpp"
 
+#include <future>
+#include <memory>
 #include <optional>
 
 namespace adit {
+
+class ChunkPool;  // registration/chunk_pool.hpp
 
 struct ScanToScanConfig {
   RegistrationConfig registration;  // keys "odometry.<field>" (see registration.hpp)
@@ -144,14 +148,23 @@ class ScanToScanOdometry {
   // Outer rounds (correspondences recomputed each) from `seed` until converged or out of rounds.
   Refinement refine(const SweepPoints& cur, const Eigen::Isometry3d& seed, const Eigen::Isometry3d& hold,
                     bool can_hold) const;
-  void setPrevious(const SweepPoints& points);
+  // in_background: build the index on another thread (when search_threads > 1).
+  void setPrevious(const SweepPoints& points, bool in_background = false);
   std::optional<LineFit> fitLocalLine(const Eigen::Vector3d& q, double max_sq) const;
   std::optional<PlaneFit> threePointPlane(const Eigen::Vector3d& q, double max_sq) const;
   std::optional<PlaneFit> fitLocalPlane(const Eigen::Vector3d& q, double max_sq) const;
 
   ScanToScanConfig config_;
-  RingIndexedCloud prev_corners_;  // previous corner_less_sharp, previous lidar frame
-  RingIndexedCloud prev_surfs_;    // previous surf_less_flat
+  std::shared_ptr<ChunkPool> pool_;  // correspondence search threads (none: search_threads 1)
+  // The previous sweep's search index: corner_less_sharp and surf_less_flat, previous lidar frame. With
+  // search_threads > 1 it is built on another thread while the rest of the pipeline runs (the same index,
+  // off the odometry's critical path) and taken over by the next match (awaitPrevious()).
+  struct PreviousIndex {
+    RingIndexedCloud corners, surfs;
+  };
+  void awaitPrevious() const;
+  mutable std::shared_ptr<const PreviousIndex> previous_ = std::make_shared<const PreviousIndex>();
+  mutable std::shared_future<std::shared_ptr<const PreviousIndex>> building_previous_;
   SweepPoints prev_points_;        // the previous sweep's features, kept to compensate them if they were raw
   bool previous_raw_ = false;      // the previous sweep was not deskewed
   bool has_previous_ = false;

@@ -178,7 +178,8 @@ ConfigTable<RegistrationConfig> registrationConfigTable(const std::string& prefi
    .add("degeneracy_prior_strength", &G::degeneracy_prior_strength, above(0), "", "stiffness of that prior relative to the largest eigenvalue")
    .add("degeneracy_remap", &G::degeneracy_remap, anyValue(), "", "set the solution along degenerate directions to the prior's (Zhang 2016)")
    .add("prior_sigma_translation_m", &G::prior_sigma_translation_m, above(0), "m", "motion-model uncertainty per sweep (covariance of degenerate directions)")
-   .add("prior_sigma_rotation_rad", &G::prior_sigma_rotation_rad, above(0), "rad", "same for rotation");
+   .add("prior_sigma_rotation_rad", &G::prior_sigma_rotation_rad, above(0), "rad", "same for rotation")
+   .add("search_threads", &G::search_threads, between(1, 64), "threads", "threads of the correspondence search (same result for any count)");
   return t;
 }
 
