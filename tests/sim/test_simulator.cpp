@@ -236,6 +236,7 @@ TEST(SimulatorConfig, ReferenceWorldFileMatchesTheDefaults) {
            {c.motion.max_decel, d.motion.max_decel}, {c.motion.lateral_accel, d.motion.lateral_accel},
            {c.motion.corner_radius, d.motion.corner_radius}, {c.motion.wander, d.motion.wander},
            {c.motion.start_still, d.motion.start_still}, {c.motion.start_speed, d.motion.start_speed},
+           {c.motion.start_distance, d.motion.start_distance}, {double(c.motion.reverse), double(d.motion.reverse)},
            {c.motion.mount_height, d.motion.mount_height},
            {c.motion.track_length, d.motion.track_length}, {c.motion.track_width, d.motion.track_width},
            {c.motion.vibration_deg, d.motion.vibration_deg}, {c.motion.bounce, d.motion.bounce},
