@@ -122,6 +122,19 @@ void writeProducts(const std::vector<std::unique_ptr<runtime::Node>>& nodes, con
   }
 }
 
+// The map bundle from the last node that owns one (the loop closer).
+void writeBundle(const std::vector<std::unique_ptr<runtime::Node>>& nodes, const std::string& dir,
+                 std::vector<std::string>& products) {
+  for (auto it = nodes.rbegin(); it != nodes.rend(); ++it) {
+    if (auto* writer = dynamic_cast<nodes::WritesBundle*>(it->get())) {
+      writer->writeBundle(dir);
+      products.push_back(dir);
+      return;
+    }
+  }
+  throw std::runtime_error("--save-bundle needs the loop_closer stage (it owns the map)");
+}
+
 }  // namespace
 
 ReplayReport runReplay(const ReplayOptions& options) {
@@ -190,6 +203,7 @@ ReplayReport runReplay(const ReplayOptions& options) {
   report.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
   report.process_cpu_seconds = processCpuSeconds();
   writeProducts(nodes, options.out_dir, report.products);
+  if (!options.save_bundle.empty()) writeBundle(nodes, options.save_bundle, report.products);
   report.peak_memory_mb = peakMemoryMb();  // after the products: building the map is part of the run
   const fs::path timing_path = fs::path(options.out_dir) / "timing.json";
   io::writeFileAtomically(timing_path.string(), timingJson(report));

@@ -22,6 +22,7 @@ struct ReplayArgs {
   std::string record_poses = "^(ODOM_SCAN|ODOM_MAPPED)$";
   bool record_all = false;
   bool no_progress = false;
+  std::string save_bundle;
 };
 
 }  // namespace
@@ -42,6 +43,9 @@ void registerReplayCommand(CLI::App& app) {
                                  "poses without points)");
   cmd->add_flag("--record-all", args->record_all, "Write every channel whole to output.lcmlog (every stage message)")
       ->excludes(record);
+  cmd->add_option("--save-bundle", args->save_bundle,
+                  "Also save the run as a map bundle folder (map, keyframes, pose graph, configuration, manifest) "
+                  "that later runs can relocalise in (--prior-map)");
   cmd->add_flag("--no-progress", args->no_progress, "No progress bar even on a terminal");
   cmd->callback([args] {
     adit::pipeline::ReplayOptions options;
@@ -49,6 +53,7 @@ void registerReplayCommand(CLI::App& app) {
     options.out_dir = args->out_dir;
     options.config = adit::runtime::loadConfig(args->configs);
     options.stages = args->stages;
+    options.save_bundle = args->save_bundle;
     options.record = args->record_all ? ".*" : args->record;
     options.record_poses = args->record_all ? "" : args->record_poses;
     if (!args->no_progress && ::isatty(STDERR_FILENO)) options.on_progress = drawProgress;
