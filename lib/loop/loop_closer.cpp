@@ -11,14 +11,6 @@
 namespace adit {
 namespace {
 
-// T with its rotation part projected back onto a rotation (through a unit quaternion).
-Eigen::Isometry3d orthonormal(const Eigen::Isometry3d& T) {
-  Eigen::Isometry3d out = Eigen::Isometry3d::Identity();
-  out.linear() = Eigen::Quaterniond(T.linear()).normalized().toRotationMatrix();
-  out.translation() = T.translation();
-  return out;
-}
-
 constexpr double kDegToRad = 3.14159265358979323846 / 180.0;
 
 // PoseEstimate's default covariance is identity: a mapper that did not estimate one leaves it so.

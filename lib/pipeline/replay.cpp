@@ -76,6 +76,14 @@ std::vector<std::unique_ptr<runtime::Node>> buildNodes(const ReplayOptions& opti
     nodes.back()->cpuTiming().setCapacity(0);
     report.stages_run.push_back(name);
   }
+  if (!options.prior_map.empty()) {
+    Config config = options.config;
+    config.set("reloc.prior_map", options.prior_map);
+    nodes.push_back(nodes::makeNode("relocaliser", config));
+    nodes.back()->timing().setCapacity(0);
+    nodes.back()->cpuTiming().setCapacity(0);
+    report.stages_run.push_back("relocaliser");
+  }
   // Only the last map writer's map.pcd is kept (writeProducts below): the others need not build one.
   bool map_written_later = false;
   for (auto it = nodes.rbegin(); it != nodes.rend(); ++it) {
