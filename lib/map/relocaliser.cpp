@@ -39,6 +39,7 @@ const ConfigTable<RelocaliserConfig>& relocaliserConfigTable() {
     ConfigTable<R> t("reloc");
     t.add("candidates", &R::candidates, between(1, 1000), "", "ring-key neighbours ranked by Scan Context distance per query")
      .add("max_verifications", &R::max_verifications, between(1, 100), "", "best candidates verified by ICP per query")
+     .add("query_sweeps", &R::query_sweeps, between(1, 100), "sweeps", "newest sweeps merged into the cloud ICP aligns")
      .add("query_distance", &R::query_distance, above(0), "m", "driving between two queries while relocalising")
      .add("query_interval_s", &R::query_interval_s, above(0), "s", "or this much sensor time between queries")
      .add("ambiguity_distance", &R::ambiguity_distance, above(0), "m", "fits farther apart than this are different places")
@@ -75,14 +76,17 @@ Relocaliser::Result Relocaliser::process(const PoseEstimate& session, const std:
   have_last_ = true;
   last_pose_ = session.pose;
   last_utime_ = session.utime;
+  if (stalled || registration_failed) recent_.clear();  // the session's motion across the gap is not trusted
+  recent_.emplace_back(session.pose, cloud);
+  while (static_cast<int>(recent_.size()) > config_.query_sweeps) recent_.pop_front();
   if (state_ == RelocState::kLocalised && (stalled || registration_failed)) {
     loseFix();
     result.lost_now = true;
   }
   if (state_ == RelocState::kRelocalising) {
-    relocalise(session, cloud, result);
+    relocalise(session, result);
   } else {
-    track(session, cloud);
+    track(session);
     if (state_ == RelocState::kRelocalising) result.lost_now = true;
   }
   result.state = state_;
@@ -98,13 +102,13 @@ void Relocaliser::loseFix() {
   ++stats_.lost;
 }
 
-void Relocaliser::relocalise(const PoseEstimate& session, const std::vector<Eigen::Vector3f>& cloud, Result& result) {
+void Relocaliser::relocalise(const PoseEstimate& session, Result& result) {
   const bool due = travelled_ - last_query_travelled_ >= config_.query_distance ||
                    static_cast<double>(session.utime - last_query_utime_) * 1e-6 >= config_.query_interval_s;
   if (!due) return;
   last_query_travelled_ = travelled_;
   last_query_utime_ = session.utime;
-  const std::optional<Fix> fix = query(session, cloud);
+  const std::optional<Fix> fix = query(session, recent_.back().second);
   pending_.erase(std::remove_if(pending_.begin(), pending_.end(),
                                 [&](const Fix& p) { return travelled_ - p.travelled > config_.consistency_window_m; }),
                  pending_.end());
@@ -129,8 +133,15 @@ void Relocaliser::relocalise(const PoseEstimate& session, const std::vector<Eige
   result.fixed_now = true;
 }
 
-CompactCloud Relocaliser::queryCloud(const std::vector<Eigen::Vector3f>& cloud) const {
-  return CompactCloud::encode(voxelDownsample(cloud, loop_.keyframe_voxel), static_cast<float>(loop_.keyframe_cloud_step));
+// The newest sweeps in the current sweep's frame, downsampled as a keyframe's cloud.
+CompactCloud Relocaliser::queryCloud(const Eigen::Isometry3d& session) const {
+  std::vector<Eigen::Vector3f> merged;
+  const Eigen::Isometry3d T_now_world = session.inverse();
+  for (const auto& [pose, points] : recent_) {
+    const Eigen::Isometry3f T = (T_now_world * pose).cast<float>();
+    for (const Eigen::Vector3f& p : points) merged.push_back(T * p);
+  }
+  return CompactCloud::encode(voxelDownsample(merged, loop_.keyframe_voxel), static_cast<float>(loop_.keyframe_cloud_step));
 }
 
 CandidateNeighbourhood Relocaliser::neighbourhood(int m) const {
@@ -149,7 +160,7 @@ std::optional<Relocaliser::Fix> Relocaliser::query(const PoseEstimate& session, 
   ++stats_.queries;
   const ScanContext context = keyframeScanContext(cloud, session.pose, loop_.level_scan_context, loop_.scan_context);
   if (context.empty() || database_.size() == 0) return std::nullopt;
-  const CompactCloud compact = queryCloud(cloud);
+  const CompactCloud compact = queryCloud(session.pose);
   struct Tried {
     Fix fix;
     LoopVerification v;
@@ -200,7 +211,7 @@ bool Relocaliser::consistent(const Fix& a, const Fix& b) const {
 }
 
 // Localised: verify the sweep against the bundle keyframes nearest its predicted map pose and refine the offset.
-void Relocaliser::track(const PoseEstimate& session, const std::vector<Eigen::Vector3f>& cloud) {
+void Relocaliser::track(const PoseEstimate& session) {
   if (travelled_ - last_query_travelled_ < config_.track_distance) return;
   last_query_travelled_ = travelled_;
   const Eigen::Isometry3d predicted = T_map_session_ * session.pose;
@@ -213,7 +224,7 @@ void Relocaliser::track(const PoseEstimate& session, const std::vector<Eigen::Ve
   bool ok = false;
   if (nearest >= 0) {
     const Eigen::Isometry3d& match = bundle_.keyframes[static_cast<std::size_t>(nearest)].pose;
-    const LoopVerification v = verifyCandidate(queryCloud(cloud), neighbourhood(nearest), {match.inverse() * predicted},
+    const LoopVerification v = verifyCandidate(queryCloud(session.pose), neighbourhood(nearest), {match.inverse() * predicted},
                                                loop_.verifier);
     const Eigen::Isometry3d refined = match * v.T_match_query;
     const bool small = translationNorm(predicted.inverse() * refined) <= config_.max_track_correction;

@@ -20,6 +20,7 @@
 #include "loop/place_match.hpp"
 #include "map/map_bundle.hpp"
 
+#include <deque>
 #include <optional>
 #include <vector>
 
@@ -28,6 +29,9 @@ namespace adit {
 struct RelocaliserConfig {
   int candidates = 25;           // ring-key neighbours ranked by Scan Context distance per query
   int max_verifications = 4;     // best candidates verified by ICP per query
+  // Sweeps merged (at their session poses) into the cloud ICP aligns: a 16-beam sweep leaves gaps between its
+  // rings that a few consecutive sweeps fill, which constrains the fit along a roadway of arches and bolts.
+  int query_sweeps = 5;
   double query_distance = 0.5;   // m driven between two queries while relocalising
   double query_interval_s = 1.0; // ... or this much sensor time
   double ambiguity_distance = 3.0;  // m: two fits farther apart than this are different places
@@ -82,12 +86,12 @@ class Relocaliser {
     Eigen::Isometry3d session = Eigen::Isometry3d::Identity();  // query's session pose
     double travelled = 0.0;         // session distance driven at the query
   };
-  void relocalise(const PoseEstimate& session, const std::vector<Eigen::Vector3f>& cloud, Result& result);
-  void track(const PoseEstimate& session, const std::vector<Eigen::Vector3f>& cloud);
+  void relocalise(const PoseEstimate& session, Result& result);
+  void track(const PoseEstimate& session);
   std::optional<Fix> query(const PoseEstimate& session, const std::vector<Eigen::Vector3f>& cloud);
   bool consistent(const Fix& a, const Fix& b) const;
   CandidateNeighbourhood neighbourhood(int match) const;
-  CompactCloud queryCloud(const std::vector<Eigen::Vector3f>& cloud) const;
+  CompactCloud queryCloud(const Eigen::Isometry3d& session) const;
   void loseFix();
 
   MapBundle bundle_;
@@ -106,6 +110,7 @@ class Relocaliser {
   double last_query_travelled_ = -1e9;
   std::int64_t last_query_utime_ = 0;
   int track_failures_ = 0;
+  std::deque<std::pair<Eigen::Isometry3d, std::vector<Eigen::Vector3f>>> recent_;  // newest query_sweeps sweeps
 };
 
 }  // namespace adit
