@@ -40,6 +40,7 @@ const ConfigTable<RelocaliserConfig>& relocaliserConfigTable() {
     t.add("candidates", &R::candidates, between(1, 1000), "", "ring-key neighbours ranked by Scan Context distance per query")
      .add("max_verifications", &R::max_verifications, between(1, 100), "", "best candidates verified by ICP per query")
      .add("query_sweeps", &R::query_sweeps, between(1, 100), "sweeps", "newest sweeps merged into the cloud ICP aligns")
+     .add("submap_neighbors", &R::submap_neighbors, between(0, 1000), "keyframes", "bundle keyframes each side of a candidate in its submap")
      .add("query_distance", &R::query_distance, above(0), "m", "driving between two queries while relocalising")
      .add("query_interval_s", &R::query_interval_s, above(0), "s", "or this much sensor time between queries")
      .add("ambiguity_distance", &R::ambiguity_distance, above(0), "m", "fits farther apart than this are different places")
@@ -148,7 +149,7 @@ CandidateNeighbourhood Relocaliser::neighbourhood(int m) const {
   CandidateNeighbourhood n;
   const int last = static_cast<int>(bundle_.keyframes.size()) - 1;
   const Eigen::Isometry3d T_m_map = bundle_.keyframes[static_cast<std::size_t>(m)].pose.inverse();
-  for (int j = std::max(0, m - loop_.verifier.submap_neighbors); j <= std::min(last, m + loop_.verifier.submap_neighbors); ++j) {
+  for (int j = std::max(0, m - config_.submap_neighbors); j <= std::min(last, m + config_.submap_neighbors); ++j) {
     n.clouds.push_back(bundle_.keyframes[static_cast<std::size_t>(j)].cloud);
     n.T_match_cloud.push_back(T_m_map * bundle_.keyframes[static_cast<std::size_t>(j)].pose);
   }

@@ -32,6 +32,10 @@ struct RelocaliserConfig {
   // Sweeps merged (at their session poses) into the cloud ICP aligns: a 16-beam sweep leaves gaps between its
   // rings that a few consecutive sweeps fill, which constrains the fit along a roadway of arches and bolts.
   int query_sweeps = 5;
+  // Bundle keyframes each side of a candidate in its submap (the loop closer uses loop.verifier.submap_neighbors,
+  // 5): a straight roadway constrains a fit along its axis only through what lies tens of metres away (niches,
+  // equipment, junctions), which a single sweep sees and a +-5 m submap does not hold.
+  int submap_neighbors = 20;
   double query_distance = 0.5;   // m driven between two queries while relocalising
   double query_interval_s = 1.0; // ... or this much sensor time
   double ambiguity_distance = 3.0;  // m: two fits farther apart than this are different places
