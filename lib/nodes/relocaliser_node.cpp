@@ -24,6 +24,7 @@ class RelocaliserNode : public runtime::Node, public WritesProducts {
     subscribe<adit::odometry_t>("mapped", "ODOM_MAPPED", [this](const adit::odometry_t& m) { onMapped(m); });
     advertise("pose", "POSE_IN_MAP");
     const RelocNodeConfig node = relocNodeConfigTable().read(config);
+    if (node.prior_map.empty()) return;  // no bundle asked for: the run maps from scratch
     try {
       MapBundle bundle = loadMapBundle(node.prior_map);
       const std::string mismatch = bundleSensorMismatch(bundle.summary, pipelineConfigKeys(config));
