@@ -12,7 +12,7 @@ The truth is expressed in the map frame through the mapping drive's own estimate
 own drift. Time to first fix: sensor time from the first sweep, and the relocaliser's wall time until then.
 Inside = the drive starts within 3 m of the mapped path; outside = every pose of the drive is > 40 m from it.
 
-  scripts/bench_reloc.py [--drives 50] [--outside 10] [--duration 12] [--map-duration 200] [--jobs 2]
+  scripts/bench_reloc.py [--worlds W ...] [--drives 50] [--outside 10] [--duration 20] [--map-duration 200] [--jobs 2]
 Needs a build (build/bin/adit) and numpy (Debian python3-numpy: run with /usr/bin/python3). Keeps its runs in
 logs/bench-reloc/ and prints a Markdown table.
 """
@@ -55,14 +55,15 @@ def angle_deg(R):
     return math.degrees(math.acos(max(-1.0, min(1.0, (np.trace(R) - 1) / 2))))
 
 
-def map_world(world, duration, seed):
+def map_world(world, duration, seed, build=True):
     d = os.path.join(OUT, world)
     os.makedirs(d, exist_ok=True)
     log, gt = os.path.join(d, "map.lcmlog"), os.path.join(d, "map_gt.tum")
-    run(["sim", "--world", world, "--duration", str(duration), "--seed", str(seed), "-o", log, "--gt", gt])
-    run(["replay", log, "-o", os.path.join(d, "map_run"), "--save-bundle", os.path.join(d, "bundle"), "--no-progress",
-         "--record", "^$"])
-    os.remove(log)
+    if build:
+        run(["sim", "--world", world, "--duration", str(duration), "--seed", str(seed), "-o", log, "--gt", gt])
+        run(["replay", log, "-o", os.path.join(d, "map_run"), "--save-bundle", os.path.join(d, "bundle"),
+             "--no-progress", "--record", "^$"])
+        os.remove(log)
     truth, est = read_tum(gt), read_tum(os.path.join(d, "map_run", "trajectory.tum"))
     keys = sorted(k for k in truth if k in est)
     positions = np.array([truth[k][:3, 3] for k in keys])
@@ -83,6 +84,11 @@ def short_drive(world, m, seed, index, start, reverse, duration):
     run(["replay", log, "-o", os.path.join(d, "run"), "--prior-map", os.path.join(m["dir"], "bundle"), "--no-progress",
          "--record", "^$"])
     os.remove(log)
+    return judge(m, d, index, start, reverse)
+
+
+def judge(m, d, index, start, reverse):
+    gt = os.path.join(d, "gt.tum")
     truth = read_tum(gt)
     fix = read_tum(os.path.join(d, "run", "map_trajectory.tum"))
     summary = json.load(open(os.path.join(d, "run", "relocalisation.json")))
@@ -97,7 +103,6 @@ def short_drive(world, m, seed, index, start, reverse, duration):
         E = np.linalg.inv(truth[t]) @ m["anchors"][nearest] @ fix[t]
         out["error_m"], out["error_deg"] = float(np.linalg.norm(E[:3, 3])), angle_deg(E[:3, :3])
         out["success"] = out["error_m"] <= 0.3 and out["error_deg"] <= 2.0
-    shutil.rmtree(os.path.join(d, "run", "output.lcmlog"), ignore_errors=True)
     return out
 
 
@@ -134,17 +139,34 @@ def table(world, results):
     return rows
 
 
+def judge_only(a):
+    lines = []
+    for world in a.worlds:
+        m = map_world(world, 0, a.seed, build=False)
+        results = []
+        for name in sorted(os.listdir(m["dir"])):
+            d = os.path.join(m["dir"], name)
+            if name.startswith("drive") and os.path.exists(os.path.join(d, "run", "relocalisation.json")):
+                results.append(judge(m, d, int(name[5:]), float("nan"), None))
+        lines += table(world, results)
+    print("\n".join(lines))
+
+
 def main():
     p = argparse.ArgumentParser()
     p.add_argument("--worlds", nargs="+", default=["roadway-loop", "room-and-pillar"])
     p.add_argument("--drives", type=int, default=50)
     p.add_argument("--outside", type=int, default=10)
-    p.add_argument("--duration", type=float, default=12.0)
+    p.add_argument("--duration", type=float, default=20.0)
     p.add_argument("--map-duration", type=float, default=200.0)
     p.add_argument("--jobs", type=int, default=2)
     p.add_argument("--seed", type=int, default=1)
+    p.add_argument("--judge-only", action="store_true", help="judge the drives already in logs/bench-reloc again")
     a = p.parse_args()
-    shutil.rmtree(OUT, ignore_errors=True)
+    if a.judge_only:
+        return judge_only(a)
+    for world in a.worlds:
+        shutil.rmtree(os.path.join(OUT, world), ignore_errors=True)
     lines = ["| world | starts | drives | success (0.3 m / 2 deg) | of them fixed within 2 s | wrong | no fix | "
              "time to first fix, sensor s (median / max) | compute ms (median) |", "|---|---|---|---|---|---|---|---|---|"]
     for world in a.worlds:
