@@ -96,6 +96,7 @@ class ByteReader {
   }
   bool ok() const { return ok_; }
   bool atEnd() const { return pos_ == size_; }
+  std::size_t left() const { return size_ - pos_; }
   void fail() { ok_ = false; }
 
  private:

@@ -11,14 +11,6 @@
 namespace adit {
 namespace {
 
-// T with its rotation part projected back onto a rotation (through a unit quaternion).
-Eigen::Isometry3d orthonormal(const Eigen::Isometry3d& T) {
-  Eigen::Isometry3d out = Eigen::Isometry3d::Identity();
-  out.linear() = Eigen::Quaterniond(T.linear()).normalized().toRotationMatrix();
-  out.translation() = T.translation();
-  return out;
-}
-
 constexpr double kDegToRad = 3.14159265358979323846 / 180.0;
 
 // PoseEstimate's default covariance is identity: a mapper that did not estimate one leaves it so.
@@ -90,8 +82,8 @@ void LoopCloser::submitJob(int query) {
     const Eigen::Isometry3d T_m_world = graph_.pose(m).inverse();
     for (int j = std::max(0, m - config_.verifier.submap_neighbors);
          j <= std::min(newest_allowed, m + config_.verifier.submap_neighbors); ++j) {
-      snap.clouds.push_back(keyframes_[static_cast<std::size_t>(j)].cloud);
-      snap.T_match_cloud.push_back(T_m_world * graph_.pose(j));
+      snap.neighbourhood.clouds.push_back(keyframes_[static_cast<std::size_t>(j)].cloud);
+      snap.neighbourhood.T_match_cloud.push_back(T_m_world * graph_.pose(j));
     }
     job.candidates.push_back(std::move(snap));
   }
@@ -198,11 +190,8 @@ void LoopCloser::addKeyframe(const PoseEstimate& mapped, const LidarScan& cloud)
   }
   sweeps_since_keyframe_.clear();
 
-  if (config_.level_scan_context) {
-    const Eigen::Matrix3f L = levellingRotation(mapped.pose).cast<float>();
-    for (Eigen::Vector3f& p : points) p = L * p;
-  }
-  database_.add(ScanContext::build(points, config_.scan_context), kf.utime);
+  database_.add(keyframeScanContext(std::move(points), mapped.pose, config_.level_scan_context, config_.scan_context),
+                kf.utime);
   keyframes_.push_back(std::move(kf));
   ++stats_.keyframes;
 }

@@ -146,6 +146,7 @@ class LoopCloser {
   };
   const std::vector<Keyframe>& keyframes() const { return keyframes_; }
   const PoseGraph& graph() const { return graph_; }
+  const ScanContext& keyframeContext(int keyframe) const { return database_.context(keyframe); }
   const std::vector<LoopConstraint>& acceptedLoops() const { return accepted_; }
   const LoopCloserStats& stats() const { return stats_; }
   const LoopCloserConfig& config() const { return config_; }

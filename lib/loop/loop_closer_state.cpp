@@ -1,6 +1,7 @@
 // LoopCloser state <-> bytes, for checkpoints: everything process() depends on, so a restored loop closer
 // continues exactly as the one that wrote the checkpoint would have (same keyframes, graph, pending loops).
 #include "core/byte_codec.hpp"
+#include "loop/keyframe_codec.hpp"
 #include "loop/loop_closer.hpp"
 
 namespace adit {
@@ -61,14 +62,8 @@ std::string LoopCloser::keyframeRecord(int k) const {
   const Keyframe& kf = keyframes_[static_cast<std::size_t>(k)];
   w.put<std::int64_t>(kf.utime);
   w.putPose(kf.uncorrected);
-  w.put<float>(kf.cloud.step());
-  w.put<std::uint64_t>(kf.cloud.counts().size());
-  for (std::int16_t c : kf.cloud.counts()) w.put<std::int16_t>(c);
-  const ScanContext& sc = database_.context(k);
-  w.put<std::int32_t>(sc.rings());
-  w.put<std::int32_t>(sc.sectors());
-  w.put<std::int32_t>(sc.shiftSearchRadius());
-  w.putMatrix(sc.descriptor());
+  putCompactCloud(w, kf.cloud);
+  putScanContext(w, database_.context(k));
   w.putMatrix(chain_.stepCovariance(k));
   return w.bytes();
 }
@@ -115,24 +110,15 @@ bool LoopCloser::restoreState(const std::string& state, const std::vector<std::s
     Keyframe kf;
     kf.utime = kr.get<std::int64_t>();
     kf.uncorrected = kr.getPose();
-    const float cloud_step = kr.get<float>();
-    std::vector<std::int16_t> counts(kr.getCount(sizeof(std::int16_t)));
-    for (std::int16_t& c : counts) c = kr.get<std::int16_t>();
-    std::optional<CompactCloud> cloud = CompactCloud::fromCounts(cloud_step, std::move(counts));
-    if (!kr.ok() || !cloud) return false;
+    std::optional<CompactCloud> cloud = getCompactCloud(kr);
+    std::optional<ScanContext> context = cloud ? getScanContext(kr) : std::nullopt;
+    if (!context) return false;
     kf.cloud = std::move(*cloud);
-    const int rings = kr.get<std::int32_t>(), sectors = kr.get<std::int32_t>(), radius = kr.get<std::int32_t>();
-    if (!kr.ok() || rings <= 0 || sectors <= 0 || rings > 1000 || sectors > 1000 ||
-        static_cast<std::uint64_t>(rings) * static_cast<std::uint64_t>(sectors) * 4 > record.size())
-      return false;
-    Eigen::MatrixXf descriptor(rings, sectors);
-    for (int i = 0; i < rings; ++i)
-      for (int j = 0; j < sectors; ++j) descriptor(i, j) = kr.get<float>();
     const Matrix6d step = kr.getMatrix<Matrix6d>();
     if (!kr.ok() || !kr.atEnd()) return false;
     restored.chain_.add(kf.uncorrected, step);
     restored.graph_.addNode(r.getPose());
-    restored.database_.add(ScanContext::fromDescriptor(descriptor, radius), kf.utime);
+    restored.database_.add(*context, kf.utime);
     restored.keyframes_.push_back(std::move(kf));
   }
   const auto edges = r.getCount(4 + 4 + 96 + 288 + 1);

@@ -8,12 +8,6 @@
 namespace adit {
 namespace {
 
-Eigen::Isometry3d rotationOnly(const Eigen::Matrix3d& R) {
-  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.linear() = R;
-  return T;
-}
-
 Matrix6d loopCovariance(const LoopCloserConfig& config) {
   const double vt = config.loop_translation_sigma * config.loop_translation_sigma;
   const double vr = config.loop_rotation_sigma * config.loop_rotation_sigma;
@@ -60,27 +54,14 @@ class JobRun {
   }
 
   std::optional<LoopConstraint> verify(const LoopCandidateSnapshot& c) {
-    // Decoded here, on the worker: the main thread only copies the compact clouds into the job.
-    std::vector<std::vector<Eigen::Vector3f>> clouds;
-    clouds.reserve(c.clouds.size());
-    for (const CompactCloud& cloud : c.clouds) clouds.push_back(cloud.decode());
-    std::vector<SubmapPiece> pieces;
-    for (std::size_t i = 0; i < clouds.size(); ++i) pieces.push_back({&clouds[i], c.T_match_cloud[i]});
-    const std::vector<Eigen::Vector3f> submap = buildSubmap(pieces, config_.verifier.submap_voxel);
-
-    // Seeds: the Scan Context yaw at zero offset (levelled frames: query = Rz(yaw) * match), then the graph's
-    // current relative pose.
+    // Seeds: the Scan Context yaw, then the graph's current relative pose. The clouds are decoded here, on the
+    // worker: the main thread only copies the compact clouds into the job.
     const int m = c.candidate.index;
-    Eigen::Matrix3d L_q = Eigen::Matrix3d::Identity(), L_m = Eigen::Matrix3d::Identity();
-    if (config_.level_scan_context) {
-      L_q = levellingRotation(job_.query_uncorrected);
-      L_m = levellingRotation(c.match_uncorrected);
-    }
-    const Eigen::Matrix3d R_yaw = Eigen::AngleAxisd(-c.candidate.yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
     const Eigen::Isometry3d T_graph = job_.graph.pose(m).inverse() * job_.graph.pose(job_.query);
-    const std::vector<Eigen::Isometry3d> seeds{rotationOnly(L_m.transpose() * R_yaw * L_q), T_graph};
-
-    const LoopVerification v = verifyLoop(job_.query_cloud.decode(), submap, seeds, config_.verifier);
+    const std::vector<Eigen::Isometry3d> seeds{
+        scanContextSeed(job_.query_uncorrected, c.match_uncorrected, c.candidate.yaw, config_.level_scan_context),
+        T_graph};
+    const LoopVerification v = verifyCandidate(job_.query_cloud, c.neighbourhood, seeds, config_.verifier);
     if (v.verdict == LoopVerdict::kDegenerate) {
       ++counts_.rejected_degenerate;
       return std::nullopt;
@@ -175,12 +156,6 @@ class JobRun {
 };
 
 }  // namespace
-
-Eigen::Matrix3d levellingRotation(const Eigen::Isometry3d& T_world_lidar) {
-  const Eigen::Matrix3d R = T_world_lidar.linear();
-  const double yaw = std::atan2(R(1, 0), R(0, 0));
-  return Eigen::AngleAxisd(-yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix() * R;
-}
 
 LoopJobOutcome runLoopJob(const LoopJob& job, LoopBook& book, const LoopCloserConfig& config) {
   return JobRun(job, book, config).run();

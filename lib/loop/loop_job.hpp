@@ -11,6 +11,7 @@
 #pragma once
 
 #include "loop/loop_closer.hpp"
+#include "loop/place_match.hpp"
 #include "loop/serial_worker.hpp"
 
 #include <deque>
@@ -31,8 +32,7 @@ struct LoopCandidateSnapshot {
   ScanContextCandidate candidate;
   std::int64_t match_utime = 0;
   Eigen::Isometry3d match_uncorrected = Eigen::Isometry3d::Identity();
-  std::vector<CompactCloud> clouds;                  // the candidate's neighbours, lidar frame
-  std::vector<Eigen::Isometry3d> T_match_cloud;      // each at its graph pose relative to the candidate
+  CandidateNeighbourhood neighbourhood;  // the candidate's neighbours, each at its graph pose relative to it
 };
 
 struct LoopJob {
@@ -56,9 +56,6 @@ struct LoopJobOutcome {
 };
 
 LoopJobOutcome runLoopJob(const LoopJob& job, LoopBook& book, const LoopCloserConfig& config);
-
-// Rotation that removes the heading of a pose but keeps its roll and pitch: levelled = L * lidar.
-Eigen::Matrix3d levellingRotation(const Eigen::Isometry3d& T_world_lidar);
 
 // Jobs in flight and when each is due. Wall time spent waiting for the worker is kept for STATUS only.
 class LoopScheduler {

@@ -40,4 +40,11 @@ double mahalanobisSquared(const Vector6d& e, const Matrix6d& S) {
   return e.dot(llt.solve(e));
 }
 
+Eigen::Isometry3d orthonormal(const Eigen::Isometry3d& T) {
+  Eigen::Isometry3d out = Eigen::Isometry3d::Identity();
+  out.linear() = Eigen::Quaterniond(T.linear()).normalized().toRotationMatrix();
+  out.translation() = T.translation();
+  return out;
+}
+
 }  // namespace adit

@@ -14,6 +14,9 @@ Vector6d boxMinus(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b);
 // Adjoint of T for right perturbations: T * Exp(xi) = Exp(adjoint(T) * xi) * T, tangent order (t, r).
 Matrix6d adjoint(const Eigen::Isometry3d& T);
 
+// T with its rotation part projected back onto a rotation (through a unit quaternion).
+Eigen::Isometry3d orthonormal(const Eigen::Isometry3d& T);
+
 // Symmetric, finite and positive definite (LLT succeeds)?
 bool isValidCovariance(const Matrix6d& covariance);
 

@@ -4,11 +4,13 @@
 #include "core/geometry.hpp"
 #include "loop/loop_closer.hpp"
 #include "loop/pose_graph.hpp"
+#include "map/map_bundle.hpp"
 #include "map/map_products.hpp"
 #include "map/map_updates.hpp"
 #include "msg/convert.hpp"
 #include "nodes/node_config.hpp"
 #include "nodes/products.hpp"
+#include "nodes/registry.hpp"
 #include "nodes/run_state.hpp"
 #include "runtime/record_log.hpp"
 
@@ -28,13 +30,13 @@ constexpr const char* kKeyframesKind = "loop_closer_keyframes";
 // The loop closer owns the corrected map of a run: its keyframes are the submaps (each keyframe's cloud
 // anchored to the keyframe), the pose graph places them. It answers save_map, publishes MAP_UPDATE for
 // viewers, and checkpoints keyframes and graph so that a restart keeps what was mapped before it.
-class LoopCloserNode : public runtime::Node, public WritesProducts {
+class LoopCloserNode : public runtime::Node, public WritesProducts, public WritesBundle {
  public:
   explicit LoopCloserNode(const Config& config)
       : Node("loop_closer"), closer_(loopCloserConfigFrom(config)),
         map_voxel_(loopCloserNodeConfigTable().read(config).map_voxel),
         checkpoint_keyframes_(loopCloserNodeConfigTable().read(config).checkpoint_keyframes),
-        updates_(mapUpdateConfigFrom(config)), state_("loop_closer") {
+        updates_(mapUpdateConfigFrom(config)), config_keys_(pipelineConfigKeys(config)), state_("loop_closer") {
     subscribe<adit::odometry_t>("mapped", "ODOM_MAPPED", [this](const adit::odometry_t& m) { onMapped(m); });
     subscribe<adit::command_t>("command", "MAPPER_COMMAND", [this](const adit::command_t& m) { onCommand(m); },
                                runtime::InputKind::Requests);
@@ -47,6 +49,9 @@ class LoopCloserNode : public runtime::Node, public WritesProducts {
     return writeMapProducts(closer_, uncorrected_, map_voxel_, out_dir);
   }
   bool writesMap() const override { return true; }
+  void writeBundle(const std::string& dir) override {
+    writeMapBundle(bundleFrom(closer_, map_voxel_, config_keys_), dir);
+  }
 
   void useRunFolder(const runtime::RunFolder& folder) override {
     state_.setFolder(folder);
@@ -115,8 +120,9 @@ class LoopCloserNode : public runtime::Node, public WritesProducts {
   // anyone on the bus, and must not choose where the process writes.
   void onCommand(const adit::command_t& m) {
     if (!commandAuthentic("command", m)) return;
-    if (m.command != "save_map") {
-      reportError("unknown_command", "unknown command '" + runtime::printableText(m.command) + "' (known: save_map)");
+    if (m.command != "save_map" && m.command != "save_bundle") {
+      reportError("unknown_command",
+                  "unknown command '" + runtime::printableText(m.command) + "' (known: save_map, save_bundle)");
       return;
     }
     if (!m.argument.empty()) {
@@ -127,7 +133,21 @@ class LoopCloserNode : public runtime::Node, public WritesProducts {
         return;
       }
     }
+    if (m.command == "save_bundle") return saveBundle(m.argument.empty() ? "map_bundle" : m.argument);
     saveProducts(productNamesFor(m.argument));
+  }
+
+  // save_bundle [NAME]: a map bundle folder NAME (default map_bundle) in the run folder, for later runs'
+  // --prior-map. Written into a temporary folder and renamed, so an older bundle of that name stays whole.
+  void saveBundle(const std::string& name) {
+    try {
+      const std::string dir = state_.folder().file(name);
+      writeBundle(dir);
+      count("bundles_saved");
+      spdlog::info("[loop_closer] saved map bundle {} ({} keyframes)", dir, closer_.stats().keyframes);
+    } catch (const std::exception& e) {
+      reportError("save_failed", std::string("save_bundle: ") + e.what());
+    }
   }
 
   void saveProducts(const MapProductNames& names) {
@@ -256,6 +276,7 @@ class LoopCloserNode : public runtime::Node, public WritesProducts {
   double map_voxel_;
   int checkpoint_keyframes_;
   MapUpdateTracker updates_;
+  std::map<std::string, std::string> config_keys_;  // every pipeline key, for the bundle's config.yaml
   runtime::RecordLog keyframes_log_;  // the writer thread's, once the run started
   std::shared_ptr<std::atomic<std::size_t>> keyframes_written_ = std::make_shared<std::atomic<std::size_t>>(0);
   RunState state_;  // after what its jobs use: its writer thread stops first

@@ -3,6 +3,7 @@
 #include "features/feature_config.hpp"
 #include "loop/loop_closer.hpp"
 #include "map/map_updates.hpp"
+#include "map/relocaliser.hpp"
 #include "mapping/scan_to_map.hpp"
 #include "odometry/initial_guess.hpp"
 #include "odometry/scan_to_scan.hpp"
@@ -90,6 +91,17 @@ const ConfigTable<LoopCloserNodeConfig>& loopCloserNodeConfigTable() {
   return table;
 }
 
+const ConfigTable<RelocNodeConfig>& relocNodeConfigTable() {
+  using N = RelocNodeConfig;
+  static const ConfigTable<N> table = [] {
+    ConfigTable<N> t("reloc");
+    t.add("prior_map", &N::prior_map, anyValue(), "", "map bundle folder to relocalise in (\"\" = none: map from scratch)")
+     .add("mode", &N::mode, oneOf({"localise"}), "", "localise: the bundle stays fixed, the pose in it is published");
+    return t;
+  }();
+  return table;
+}
+
 const std::vector<std::string>& foreignConfigSections() {
   static const std::vector<std::string> sections{"sim", "lidar_driver", "pcd", "imu_csv", "eval"};
   return sections;
@@ -117,6 +129,8 @@ std::vector<ConfigKeyInfo> pipelineConfigDescription(const Config& c) {
   describeInto(mapperNodeConfigTable(), mapperNodeConfigTable().read(c), keys);
   describeInto(loopCloserNodeConfigTable(), loopCloserNodeConfigTable().read(c), keys);
   describeInto(mapUpdateConfigTable(), mapUpdateConfigFrom(c), keys);
+  describeInto(relocaliserConfigTable(), relocaliserConfigTable().read(c), keys);
+  describeInto(relocNodeConfigTable(), relocNodeConfigTable().read(c), keys);
   describeInto(inputCheckConfigTable(), inputCheckConfigTable().read(c), keys);
   std::vector<ConfigKeyInfo> out;
   for (auto& kv : keys) out.push_back(std::move(kv.second));

@@ -45,6 +45,13 @@ struct LoopCloserNodeConfig {
   int checkpoint_keyframes = 10;  // key "loop.node.checkpoint_keyframes": keyframes between checkpoints (0 = never)
 };
 
+// Keys "reloc.prior_map" and "reloc.mode": the map bundle a run relocalises in (issue 18; "" = none, the run
+// maps from scratch) and what it does there (localise: the bundle stays fixed; extend is not built yet).
+struct RelocNodeConfig {
+  std::string prior_map;
+  std::string mode = "localise";
+};
+
 // Section `input`: the bus input checks every node applies (runtime/node.hpp InputChecks, msg/validate.hpp
 // InputLimits, msg/wire_check.hpp WireLimits), the same for every stage, so one file can tighten them for a
 // deployment (e.g. the IMU's real full scale) or loosen one that refuses a real sensor. Defaults are theirs.
@@ -68,6 +75,7 @@ const ConfigTable<FeatureNodeConfig>& featureNodeConfigTable();
 const ConfigTable<OdometryNodeConfig>& odometryNodeConfigTable();
 const ConfigTable<MapperNodeConfig>& mapperNodeConfigTable();
 const ConfigTable<LoopCloserNodeConfig>& loopCloserNodeConfigTable();
+const ConfigTable<RelocNodeConfig>& relocNodeConfigTable();
 
 // Top-level sections read by code other than the pipeline (see above).
 const std::vector<std::string>& foreignConfigSections();

@@ -20,4 +20,12 @@ class WritesProducts {
   virtual void mapWrittenLater() {}
 };
 
+// The map owner (the loop closer) also writes a map bundle (map/map_bundle.hpp) for later runs to start from.
+class WritesBundle {
+ public:
+  virtual ~WritesBundle() = default;
+  // Writes the bundle folder atomically; throws std::runtime_error naming what failed.
+  virtual void writeBundle(const std::string& dir) = 0;
+};
+
 }  // namespace adit::nodes

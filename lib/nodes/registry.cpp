@@ -5,6 +5,7 @@
 #include "nodes/mapper_node.hpp"
 #include "nodes/node_config.hpp"
 #include "nodes/odometry_node.hpp"
+#include "nodes/relocaliser_node.hpp"
 #include "runtime/process.hpp"
 
 namespace adit::nodes {
@@ -21,6 +22,7 @@ std::unique_ptr<runtime::Node> makeNode(const std::string& name, const Config& c
   else if (name == "odometry") node = makeOdometryNode(config);
   else if (name == "mapper") node = makeMapperNode(config);
   else if (name == "loop_closer") node = makeLoopCloserNode(config);
+  else if (name == "relocaliser") node = makeRelocaliserNode(config);
   else throw std::runtime_error("no pipeline node named '" + name + "'");
   node->setInputChecks(inputChecksFrom(config));
   return node;

@@ -11,7 +11,8 @@
 
 namespace adit::nodes {
 
-// Pipeline order: feature -> odometry -> mapper -> loop_closer.
+// Pipeline order: feature -> odometry -> mapper -> loop_closer. makeNode also builds "relocaliser" (after
+// the mapper; only for a run given a map bundle, reloc.prior_map).
 const std::vector<std::string>& pipelineNodeNames();
 
 // Builds a node from the whole configuration (it reads its own section) after validating all of it

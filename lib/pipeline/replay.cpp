@@ -76,6 +76,14 @@ std::vector<std::unique_ptr<runtime::Node>> buildNodes(const ReplayOptions& opti
     nodes.back()->cpuTiming().setCapacity(0);
     report.stages_run.push_back(name);
   }
+  if (!options.prior_map.empty()) {
+    Config config = options.config;
+    config.set("reloc.prior_map", options.prior_map);
+    nodes.push_back(nodes::makeNode("relocaliser", config));
+    nodes.back()->timing().setCapacity(0);
+    nodes.back()->cpuTiming().setCapacity(0);
+    report.stages_run.push_back("relocaliser");
+  }
   // Only the last map writer's map.pcd is kept (writeProducts below): the others need not build one.
   bool map_written_later = false;
   for (auto it = nodes.rbegin(); it != nodes.rend(); ++it) {
@@ -120,6 +128,19 @@ void writeProducts(const std::vector<std::unique_ptr<runtime::Node>>& nodes, con
     for (const auto& path : writer->writeProducts(out_dir))
       if (std::find(products.begin(), products.end(), path) == products.end()) products.push_back(path);
   }
+}
+
+// The map bundle from the last node that owns one (the loop closer).
+void writeBundle(const std::vector<std::unique_ptr<runtime::Node>>& nodes, const std::string& dir,
+                 std::vector<std::string>& products) {
+  for (auto it = nodes.rbegin(); it != nodes.rend(); ++it) {
+    if (auto* writer = dynamic_cast<nodes::WritesBundle*>(it->get())) {
+      writer->writeBundle(dir);
+      products.push_back(dir);
+      return;
+    }
+  }
+  throw std::runtime_error("--save-bundle needs the loop_closer stage (it owns the map)");
 }
 
 }  // namespace
@@ -190,6 +211,7 @@ ReplayReport runReplay(const ReplayOptions& options) {
   report.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
   report.process_cpu_seconds = processCpuSeconds();
   writeProducts(nodes, options.out_dir, report.products);
+  if (!options.save_bundle.empty()) writeBundle(nodes, options.save_bundle, report.products);
   report.peak_memory_mb = peakMemoryMb();  // after the products: building the map is part of the run
   const fs::path timing_path = fs::path(options.out_dir) / "timing.json";
   io::writeFileAtomically(timing_path.string(), timingJson(report));

@@ -31,6 +31,11 @@ struct ReplayOptions {
   // Regex of odometry_t channels not matched by `record` written to output.lcmlog as the pose alone (points
   // stripped): the trajectory in a few hundred bytes a sweep. "" = none.
   std::string record_poses;
+  // Relocalise in this map bundle (reloc.prior_map): adds the relocaliser stage after the others, which writes
+  // map_trajectory.tum (poses in the bundle's frame, from the first fix on) and relocalisation.json.
+  std::string prior_map;
+  // Also write a map bundle (map/map_bundle.hpp) of the run into this folder ("" = none); needs the loop closer.
+  std::string save_bundle;
   // Called now and then with the fraction of the input consumed (progress bars).
   std::function<void(double)> on_progress;
 };

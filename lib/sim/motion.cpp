@@ -54,6 +54,8 @@ MotionConfig motionConfigFrom(const adit::Config& cfg) {
   c.wander = cfg.get(p + "wander", c.wander);
   c.start_still = cfg.get(p + "start_still", c.start_still);
   c.start_speed = cfg.get(p + "start_speed", c.start_speed);
+  c.start_distance = cfg.get(p + "start_distance", c.start_distance);
+  c.reverse = cfg.get(p + "reverse", c.reverse);
   c.mount_height = cfg.get(p + "mount_height", c.mount_height);
   c.track_length = cfg.get(p + "track_length", c.track_length);
   c.track_width = cfg.get(p + "track_width", c.track_width);
@@ -181,16 +183,44 @@ GroundContact trackPlane(const World& world, const Eigen::Vector2d& xy, double y
 
 }  // namespace
 
+std::vector<Eigen::Vector2d> routeFrom(const std::vector<Eigen::Vector2d>& route, bool closed, double distance,
+                                       bool reverse) {
+  std::vector<Eigen::Vector2d> r(route);
+  if (reverse) std::reverse(r.begin(), r.end());
+  if (r.size() < 2 || !(distance > 0.0)) return r;
+  double length = 0.0;
+  for (std::size_t i = 1; i < r.size(); ++i) length += (r[i] - r[i - 1]).norm();
+  if (closed && length > 0.0) distance = std::fmod(distance, length);
+  // Segment i (r[i] -> r[i + 1]) holding the start, and the start point on it.
+  std::size_t i = 0;
+  double along = distance;
+  while (i + 2 < r.size() && along > (r[i + 1] - r[i]).norm()) along -= (r[i + 1] - r[i]).norm(), ++i;
+  const Eigen::Vector2d d = r[i + 1] - r[i];
+  const Eigen::Vector2d start = r[i] + std::min(along, d.norm()) / std::max(1e-9, d.norm()) * d;
+  std::vector<Eigen::Vector2d> out{start};
+  out.insert(out.end(), r.begin() + static_cast<std::ptrdiff_t>(i + 1), r.end());
+  if (closed) {
+    out.insert(out.end(), r.begin() + 1, r.begin() + static_cast<std::ptrdiff_t>(i + 1));
+    out.push_back(start);
+  }
+  // A start on a waypoint would repeat it (a zero-length segment).
+  out.erase(std::unique(out.begin(), out.end(), [](const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+              return (a - b).norm() < 1e-6;
+            }), out.end());
+  return out;
+}
+
 PlannedMotion planMotion(const World& world, const MotionConfig& c, double duration, std::uint64_t seed) {
   Rng rng = Rng::forStream(seed, Stream::Motion);
   const double horizon = std::max(0.0, duration) + 1.0;
 
   // Route: repeat closed routes until they cover the horizon at full speed.
-  std::vector<Eigen::Vector2d> waypoints = world.route;
-  if (world.route_closed && world.route.size() > 2) {
+  const std::vector<Eigen::Vector2d> route = routeFrom(world.route, world.route_closed, c.start_distance, c.reverse);
+  std::vector<Eigen::Vector2d> waypoints = route;
+  if (world.route_closed && route.size() > 2) {
     const double lap = std::max(1.0, world.routeLength());
     const int laps = 1 + static_cast<int>(std::ceil(horizon * c.max_speed / lap));
-    for (int k = 1; k < laps; ++k) waypoints.insert(waypoints.end(), world.route.begin() + 1, world.route.end());
+    for (int k = 1; k < laps; ++k) waypoints.insert(waypoints.end(), route.begin() + 1, route.end());
   }
   const Path2d path(waypoints, c.corner_radius);
   // The smoothing below reaches smoothing_window back in time: start moving that much later so the robot is
@@ -207,7 +237,7 @@ PlannedMotion planMotion(const World& world, const MotionConfig& c, double durat
 
   PlannedMotion out;
   out.route_length = path.length();
-  out.lap_length = Path2d(world.route, c.corner_radius).length();
+  out.lap_length = Path2d(route, c.corner_radius).length();
   const double dt = c.knot_spacing;
   const int controls = static_cast<int>(std::ceil(horizon / dt)) + 4;
   auto knotTime = [dt](int k) { return (k - 1) * dt; };  // control k belongs to time (k - 1) dt

@@ -38,6 +38,10 @@ struct MotionConfig {
   double wander = 0.15;          // m, amplitude of the lateral wander around the centre line
   double start_still = 2.0;      // s standing still at the start (ignored when start_speed > 0)
   double start_speed = 0.0;      // m/s already driven at time 0 (capped by the speed limits there); 0 = from rest
+  // Where on the route the drive starts (m along it; closed routes wrap round, open ones drop what lies before)
+  // and in which direction: a later drive through a mapped roadway that starts somewhere else (issue 18).
+  double start_distance = 0.0;
+  bool reverse = false;  // drive the route backwards
   double mount_height = 1.0;     // m, lidar above the ground contact
   double track_length = 1.2;     // m, length of the tracks on the ground (pitch from the floor)
   double track_width = 0.8;      // m, distance between the tracks (roll from the floor)
@@ -60,6 +64,11 @@ struct PlannedMotion {
   double lap_length = 0.0;    // length of one pass of world.route as driven (corners rounded) (m)
   double timeAtDistance(double metres) const;  // first time the robot has driven `metres`; +inf if never
 };
+
+// The route a drive follows: reversed when asked, then starting `distance` metres along it (closed routes
+// wrap round to their start, open ones drop what lies before; a closed route's last waypoint equals its first).
+std::vector<Eigen::Vector2d> routeFrom(const std::vector<Eigen::Vector2d>& route, bool closed, double distance,
+                                       bool reverse);
 
 // Plans `duration` seconds (+1 s margin) of motion along world.route. Closed routes are repeated lap after lap.
 PlannedMotion planMotion(const World& world, const MotionConfig& config, double duration, std::uint64_t seed);

@@ -2,6 +2,8 @@
 // trajectory and pose graph into its run folder, as NAME.pcd / NAME.tum / NAME.g2o (default map.pcd,
 // trajectory.tum, pose_graph.g2o). The receiver checks the name again: anyone on the bus can publish.
 // With a key (--key / $ADIT_COMMAND_KEY) the command is signed, for processes that obey only signed ones.
+// adit command save_bundle [NAME]: the map owner writes a map bundle folder NAME (default map_bundle) into its
+// run folder, for later runs' --prior-map.
 // adit command keygen FILE: writes a new random key (mode 0600, never over an existing file).
 #include "commands.hpp"
 #include "msg/encode.hpp"
@@ -19,6 +21,7 @@
 namespace {
 
 struct CommandArgs {
+  std::string command = "save_map";
   std::string name;
   std::string lcm_url;
   std::string channel = "MAPPER_COMMAND";
@@ -36,24 +39,24 @@ void sign(adit::command_t& c, const std::string& channel, const std::string& key
   c.mac_size = static_cast<std::int32_t>(c.mac.size());
 }
 
-void publishSaveMap(const CommandArgs& a) {
+void publishSave(const CommandArgs& a) {
   if (!a.name.empty()) {
     const std::string problem = adit::runtime::plainFileNameProblem(a.name);
-    if (!problem.empty()) throw std::runtime_error("save_map '" + a.name + "': " + problem);
+    if (!problem.empty()) throw std::runtime_error(a.command + " '" + a.name + "': " + problem);
   }
   lcm::LCM lcm(a.lcm_url);
   if (!lcm.good()) throw std::runtime_error("cannot open LCM '" + a.lcm_url + "'");
   adit::command_t c{};
   c.header.utime = adit::runtime::wallUtime();
   c.header.seq = 0;
-  c.command = "save_map";
+  c.command = a.command;
   c.argument = a.name;
   const std::string key_path = adit::runtime::commandKeyPath(a.key_path);
   if (!key_path.empty()) sign(c, a.channel, key_path);
   const std::vector<std::uint8_t> bytes = adit::msg::encode(c);
   if (lcm.publish(a.channel, bytes.data(), static_cast<unsigned int>(bytes.size())) != 0)
     throw std::runtime_error("cannot publish on " + a.channel);
-  spdlog::info("sent {}save_map{} on {}", key_path.empty() ? "" : "signed ", a.name.empty() ? "" : " " + a.name,
+  spdlog::info("sent {}{}{} on {}", key_path.empty() ? "" : "signed ", a.command, a.name.empty() ? "" : " " + a.name,
                a.channel);
 }
 
@@ -61,14 +64,23 @@ void publishSaveMap(const CommandArgs& a) {
 
 void registerCommandCommand(CLI::App& app) {
   auto a = std::make_shared<CommandArgs>();
-  auto* cmd = app.add_subcommand("command", "Send a command to the running processes (save_map [NAME]), or make a key");
+  auto* cmd = app.add_subcommand("command", "Send a command to the running processes (save_map [NAME], save_bundle [NAME]), or make a key");
   cmd->require_subcommand(1);
   auto* save = cmd->add_subcommand("save_map", "The map owner saves the corrected map, trajectory and pose graph into its run folder");
   save->add_option("name", a->name, "Plain file name (NAME.pcd, NAME.tum, NAME.g2o); default map.pcd, trajectory.tum, pose_graph.g2o");
   save->add_option("--lcm-url", a->lcm_url, "LCM provider (default: $LCM_DEFAULT_URL or udpm)");
   save->add_option("--channel", a->channel, "Command channel")->capture_default_str();
   save->add_option("--key", a->key_path, "Sign with this key file (default: $ADIT_COMMAND_KEY, else unsigned)");
-  save->callback([a] { publishSaveMap(*a); });
+  save->callback([a] { publishSave(*a); });
+  auto* bundle = cmd->add_subcommand("save_bundle", "The map owner saves a map bundle folder into its run folder (for --prior-map)");
+  bundle->add_option("name", a->name, "Plain folder name (default map_bundle)");
+  bundle->add_option("--lcm-url", a->lcm_url, "LCM provider (default: $LCM_DEFAULT_URL or udpm)");
+  bundle->add_option("--channel", a->channel, "Command channel")->capture_default_str();
+  bundle->add_option("--key", a->key_path, "Sign with this key file (default: $ADIT_COMMAND_KEY, else unsigned)");
+  bundle->callback([a] {
+    a->command = "save_bundle";
+    publishSave(*a);
+  });
   auto* keygen = cmd->add_subcommand("keygen", "Write a new random command key (hex, mode 0600) to FILE; never overwrites");
   keygen->add_option("file", a->new_key_path, "Where to write the key")->required();
   keygen->callback([a] {

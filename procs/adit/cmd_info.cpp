@@ -2,9 +2,12 @@
 // and bandwidth (MB/s over the whole log's span, i.e. what the channel costs the bus and the disk), and the
 // whole log's rate.
 // adit info <file.bag>: a ROS 1 bag's topics, types, message counts, span and rate, and any lost chunk.
+// adit info <bundle folder>: a map bundle's date, keyframes, extent, roadway length, sensor keys and files
+// (every file's size and checksum are checked; a bad bundle is an error naming what is wrong).
 #include "commands.hpp"
 
 #include "io/rosbag.hpp"
+#include "map/map_bundle.hpp"
 #include "msg/type_name.hpp"
 #include "runtime/lcm_log.hpp"
 
@@ -13,6 +16,7 @@
 
 #include <algorithm>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <map>
 
@@ -56,13 +60,36 @@ void printBagSummary(const std::string& path) {
   }
 }
 
+void printBundleSummary(const std::string& dir) {
+  adit::BundleSummary s;
+  try {
+    s = adit::readBundleSummary(dir);
+  } catch (const adit::BundleError& e) {
+    spdlog::error("bad map bundle: {}", e.what());
+    throw CLI::RuntimeError(kExitDamagedInput);
+  }
+  const Eigen::Vector3d size = s.extent_max - s.extent_min;
+  fmt::print("map bundle {} (version {})\n", dir, s.version);
+  fmt::print("  created        {} (sensor time of the newest keyframe)\n", s.created);
+  fmt::print("  keyframes      {}\n", s.keyframes);
+  fmt::print("  roadway        {:.1f} m (revisits counted once)\n", s.roadway_length_m);
+  fmt::print("  extent         x {:.1f}..{:.1f}  y {:.1f}..{:.1f}  z {:.1f}..{:.1f} m ({:.1f} x {:.1f} x {:.1f} m)\n",
+             s.extent_min.x(), s.extent_max.x(), s.extent_min.y(), s.extent_max.y(), s.extent_min.z(),
+             s.extent_max.z(), size.x(), size.y(), size.z());
+  fmt::print("  map voxel      {} m\n", s.map_voxel);
+  for (const auto& [key, value] : s.sensor) fmt::print("  sensor         {} = {}\n", key, value);
+  for (const auto& [name, f] : s.files)
+    fmt::print("  file           {:<16} {:>12} bytes  crc32 {:08x}  ok\n", name, f.bytes, f.crc32);
+}
+
 }  // namespace
 
 void registerInfoCommand(CLI::App& app) {
   auto path = std::make_shared<std::string>();
-  auto* cmd = app.add_subcommand("info", "Summarise an LCM log (messages, type, time span and rate per channel) or a ROS 1 bag (topics, types, counts)");
-  cmd->add_option("log", *path, "LCM log or ROS bag")->required()->check(CLI::ExistingFile);
+  auto* cmd = app.add_subcommand("info", "Summarise an LCM log (messages, type, time span and rate per channel), a ROS 1 bag (topics, types, counts) or a map bundle");
+  cmd->add_option("log", *path, "LCM log, ROS bag or map bundle folder")->required()->check(CLI::ExistingPath);
   cmd->callback([path] {
+    if (std::filesystem::is_directory(*path)) return printBundleSummary(*path);
     if (isRosbag(*path)) return printBagSummary(*path);
     adit::runtime::LogReader reader(*path);
     std::map<std::string, ChannelStats> channels;

@@ -1,6 +1,9 @@
-// adit replay <log> -o <out_dir> [--config FILE] [--record REGEX | --record-all]
+// adit replay <log> -o <out_dir> [--config FILE] [--record REGEX | --record-all] [--save-bundle DIR]
+//             [--prior-map BUNDLE]
 #include "commands.hpp"
 
+#include "map/map_bundle.hpp"
+#include "nodes/registry.hpp"
 #include "pipeline/replay.hpp"
 #include "runtime/process.hpp"
 
@@ -22,7 +25,22 @@ struct ReplayArgs {
   std::string record_poses = "^(ODOM_SCAN|ODOM_MAPPED)$";
   bool record_all = false;
   bool no_progress = false;
+  std::string save_bundle;
+  std::string prior_map;
 };
+
+// A bundle the run cannot use is an error before anything runs, naming what is wrong. Localising keeps the
+// bundle fixed: without --stages the loop closer (whose keyframes grow with the run) is left out.
+void checkPriorMap(const std::string& dir, adit::pipeline::ReplayOptions& options) {
+  try {
+    const adit::BundleSummary summary = adit::readBundleSummary(dir);
+    const std::string mismatch = adit::bundleSensorMismatch(summary, adit::nodes::pipelineConfigKeys(options.config));
+    if (!mismatch.empty()) throw adit::BundleError(mismatch);
+  } catch (const adit::BundleError& e) {
+    throw std::runtime_error("--prior-map " + dir + " cannot be used: " + e.what());
+  }
+  if (options.stages.empty()) options.stages = {"feature", "odometry", "mapper"};
+}
 
 }  // namespace
 
@@ -42,6 +60,13 @@ void registerReplayCommand(CLI::App& app) {
                                  "poses without points)");
   cmd->add_flag("--record-all", args->record_all, "Write every channel whole to output.lcmlog (every stage message)")
       ->excludes(record);
+  cmd->add_option("--save-bundle", args->save_bundle,
+                  "Also save the run as a map bundle folder (map, keyframes, pose graph, configuration, manifest) "
+                  "that later runs can relocalise in (--prior-map)");
+  cmd->add_option("--prior-map", args->prior_map,
+                  "Start in this map bundle with no initial guess: relocalise (Scan Context + ICP), then publish the "
+                  "pose in its frame (POSE_IN_MAP, map_trajectory.tum, relocalisation.json). Mode reloc.mode "
+                  "(localise: the bundle stays fixed; the loop closer is not run unless --stages names it)");
   cmd->add_flag("--no-progress", args->no_progress, "No progress bar even on a terminal");
   cmd->callback([args] {
     adit::pipeline::ReplayOptions options;
@@ -49,6 +74,9 @@ void registerReplayCommand(CLI::App& app) {
     options.out_dir = args->out_dir;
     options.config = adit::runtime::loadConfig(args->configs);
     options.stages = args->stages;
+    options.save_bundle = args->save_bundle;
+    options.prior_map = args->prior_map;
+    if (!args->prior_map.empty()) checkPriorMap(args->prior_map, options);
     options.record = args->record_all ? ".*" : args->record;
     options.record_poses = args->record_all ? "" : args->record_poses;
     if (!args->no_progress && ::isatty(STDERR_FILENO)) options.on_progress = drawProgress;

@@ -17,7 +17,8 @@ namespace {
 struct SimArgs {
   std::vector<std::string> configs;
   std::string world, sensor, output, gt, world_pcd, lcm_url, pcap, bag, bag_compression = "none";
-  double duration_s = -1, rate = 1.0, world_spacing = 0.1, start_speed = -1;
+  double duration_s = -1, rate = 1.0, world_spacing = 0.1, start_speed = -1, start_distance = -1;
+  bool reverse = false;
   std::int64_t seed = -1;
   bool live = false, no_truth_channel = false, no_imu = false;
   std::string stall_lidar, stall_imu;
@@ -95,6 +96,10 @@ void registerSimCommand(CLI::App& app) {
                   "Already driving at this speed (m/s) at time 0, as a log cut from a drive (sim.motion.start_speed; "
                   "raise sim.motion.cruise_speed / max_speed with it for a road vehicle)")
       ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--start-distance", a->start_distance,
+                  "Start this far (m) along the world's route (sim.motion.start_distance): a later drive through "
+                  "the same roadway")->check(CLI::NonNegativeNumber);
+  cmd->add_flag("--reverse", a->reverse, "Drive the route backwards (sim.motion.reverse)");
   cmd->add_flag("--no-imu", a->no_imu, "Publish no IMU (a vehicle without one)");
   cmd->add_option("--stall-lidar", a->stall_lidar,
                   "Fault test: publish no LIDAR_POINTS (nor their GROUND_TRUTH) from START for SECONDS of sensor "
@@ -108,6 +113,8 @@ void registerSimCommand(CLI::App& app) {
     if (a->duration_s > 0) config.duration_s = a->duration_s;
     if (a->seed >= 0) config.seed = static_cast<std::uint64_t>(a->seed);
     if (a->start_speed >= 0) config.motion.start_speed = a->start_speed;
+    if (a->start_distance >= 0) config.motion.start_distance = a->start_distance;
+    if (a->reverse) config.motion.reverse = true;
 
     adit::sources::SimChannels channels;
     if (a->no_truth_channel) channels.ground_truth.clear();

@@ -153,6 +153,34 @@ TEST(SimulatorLoop, DrivesTheCircuitMoreThanOnceInTheDemoDuration) {
               "%.2f m/s^2\n", max_speed, max_accel, max_full_speed, max_full_accel);
 }
 
+// sim.motion.start_distance / reverse: a closed route starts there and wraps round, an open one drops what lies
+// before; reversed first. And a drive started 30 m into roadway-loop stands where the first drive is 30 m in.
+TEST(SimulatorMotion, StartsAtADistanceAlongTheRoute) {
+  const std::vector<Eigen::Vector2d> square{{0, 0}, {10, 0}, {10, 10}, {0, 10}, {0, 0}};
+  const auto closed = routeFrom(square, true, 15.0, false);
+  ASSERT_EQ(closed.size(), 6u);
+  EXPECT_TRUE(closed.front().isApprox(Eigen::Vector2d(10, 5)));
+  EXPECT_TRUE(closed.back().isApprox(Eigen::Vector2d(10, 5)));
+  EXPECT_TRUE(closed[1].isApprox(Eigen::Vector2d(10, 10)));
+  const auto open = routeFrom(square, false, 15.0, false);
+  ASSERT_EQ(open.size(), 4u);
+  EXPECT_TRUE(open.front().isApprox(Eigen::Vector2d(10, 5)));
+  const auto reversed = routeFrom(square, true, 5.0, true);
+  EXPECT_TRUE(reversed.front().isApprox(Eigen::Vector2d(0, 5)));
+  EXPECT_TRUE(reversed[1].isApprox(Eigen::Vector2d(0, 10)));
+  EXPECT_EQ(routeFrom(square, true, 40.0, false).front(), Eigen::Vector2d(0, 0));  // a whole lap: the start
+
+  SimConfig first = shortRun("roadway-loop", 1), later = first;
+  first.duration_s = 40.0;
+  later.motion.start_distance = 30.0;
+  const Simulator a(first), b(later);
+  const Eigen::Vector3d start = b.groundTruth(b.sweepUtime(0)).pose.translation();
+  const double t30 = a.motion().timeAtDistance(30.0);
+  const Eigen::Vector3d thirty = a.trajectory().state(t30).pose.translation();
+  // The wander around the centre line (0.15 m) and the smoothing differ between the two plans.
+  EXPECT_LT((start.head<2>() - thirty.head<2>()).norm(), 0.5) << start.transpose() << " / " << thirty.transpose();
+}
+
 // sim.motion.start_speed: the robot is already driving at t = 0, at that speed, and keeps driving; without it
 // it stands still for start_still seconds. Planned motion (flat floor, no vibration) so the speed is the plan's.
 TEST(SimulatorMotion, StartsAtTheConfiguredSpeed) {
@@ -236,6 +264,7 @@ TEST(SimulatorConfig, ReferenceWorldFileMatchesTheDefaults) {
            {c.motion.max_decel, d.motion.max_decel}, {c.motion.lateral_accel, d.motion.lateral_accel},
            {c.motion.corner_radius, d.motion.corner_radius}, {c.motion.wander, d.motion.wander},
            {c.motion.start_still, d.motion.start_still}, {c.motion.start_speed, d.motion.start_speed},
+           {c.motion.start_distance, d.motion.start_distance}, {double(c.motion.reverse), double(d.motion.reverse)},
            {c.motion.mount_height, d.motion.mount_height},
            {c.motion.track_length, d.motion.track_length}, {c.motion.track_width, d.motion.track_width},
            {c.motion.vibration_deg, d.motion.vibration_deg}, {c.motion.bounce, d.motion.bounce},

@@ -1,0 +1,250 @@
+#include "map/relocaliser.hpp"
+
+#include "core/geometry.hpp"
+#include "loop/odometry_chain.hpp"
+#include "loop/place_match.hpp"
+#include "loop/se3.hpp"
+#include "loop/voxel_filter.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace adit {
+namespace {
+
+// Covariance of a relative pose over `metres` of driving under the loop closer's odometry random walk.
+Matrix6d driftCovariance(const LoopCloserConfig& c, double metres) {
+  const double vt = c.odometry_translation_sigma * c.odometry_translation_sigma * metres +
+                    c.odometry_min_translation_sigma * c.odometry_min_translation_sigma;
+  const double vr = c.odometry_rotation_sigma * c.odometry_rotation_sigma * metres +
+                    c.odometry_min_rotation_sigma * c.odometry_min_rotation_sigma;
+  Matrix6d m = Matrix6d::Zero();
+  m.diagonal() << vt, vt, vt, vr, vr, vr;
+  return m;
+}
+
+Matrix6d fitCovariance(const LoopCloserConfig& c) {
+  const double vt = c.loop_translation_sigma * c.loop_translation_sigma;
+  const double vr = c.loop_rotation_sigma * c.loop_rotation_sigma;
+  Matrix6d m = Matrix6d::Zero();
+  m.diagonal() << vt, vt, vt, vr, vr, vr;
+  return m;
+}
+
+}  // namespace
+
+const ConfigTable<RelocaliserConfig>& relocaliserConfigTable() {
+  using R = RelocaliserConfig;
+  static const ConfigTable<R> table = [] {
+    ConfigTable<R> t("reloc");
+    t.add("candidates", &R::candidates, between(1, 1000), "", "ring-key neighbours ranked by Scan Context distance per query")
+     .add("max_verifications", &R::max_verifications, between(1, 100), "", "best candidates verified by ICP per query")
+     .add("query_sweeps", &R::query_sweeps, between(1, 100), "sweeps", "newest sweeps merged into the cloud ICP aligns")
+     .add("submap_neighbors", &R::submap_neighbors, between(0, 1000), "keyframes", "bundle keyframes each side of a candidate in its submap")
+     .add("query_distance", &R::query_distance, above(0), "m", "driving between two queries while relocalising")
+     .add("query_interval_s", &R::query_interval_s, above(0), "s", "or this much sensor time between queries")
+     .add("ambiguity_distance", &R::ambiguity_distance, above(0), "m", "fits farther apart than this are different places")
+     .add("ambiguity_margin", &R::ambiguity_margin, between(0, 1), "", "a fit elsewhere with an inlier ratio within this of the best makes the query ambiguous")
+     .add("min_consistent_fixes", &R::min_consistent_fixes, between(1, 100), "", "verified unambiguous queries that must agree before a fix")
+     .add("consistency_window_m", &R::consistency_window_m, above(0), "m", "pending fixes older than this much driving are dropped")
+     .add("track_distance", &R::track_distance, above(0), "m", "driving between tracking verifications once localised")
+     .add("max_track_correction", &R::max_track_correction, above(0), "m", "a tracking fit moving the pose more than this is refused")
+     .add("max_track_failures", &R::max_track_failures, between(1, 100000), "", "failed tracking verifications in a row that make the run lost")
+     .add("max_stall_s", &R::max_stall_s, above(0), "s", "a gap in the input longer than this makes the run lost");
+    return t;
+  }();
+  return table;
+}
+
+const char* toString(RelocState state) {
+  return state == RelocState::kLocalised ? "localised" : "relocalising";
+}
+
+Relocaliser::Relocaliser(MapBundle bundle, const LoopCloserConfig& loop, const RelocaliserConfig& config)
+    : bundle_(std::move(bundle)), loop_(loop), config_(config), database_(config.candidates) {
+  for (const BundleKeyframe& k : bundle_.keyframes) database_.add(k.context, k.utime);
+}
+
+Relocaliser::Result Relocaliser::process(const PoseEstimate& session, const std::vector<Eigen::Vector3f>& cloud,
+                                         bool registration_failed) {
+  Result result;
+  if (!session.pose.matrix().allFinite()) {
+    result.state = state_;
+    return result;
+  }
+  const bool stalled = have_last_ && static_cast<double>(session.utime - last_utime_) * 1e-6 > config_.max_stall_s;
+  if (have_last_) travelled_ += translationNorm(last_pose_.inverse() * session.pose);
+  have_last_ = true;
+  last_pose_ = session.pose;
+  last_utime_ = session.utime;
+  if (stalled || registration_failed) recent_.clear();  // the session's motion across the gap is not trusted
+  recent_.emplace_back(session.pose, cloud);
+  while (static_cast<int>(recent_.size()) > config_.query_sweeps) recent_.pop_front();
+  if (state_ == RelocState::kLocalised && (stalled || registration_failed)) {
+    loseFix();
+    result.lost_now = true;
+  }
+  if (state_ == RelocState::kRelocalising) {
+    relocalise(session, result);
+  } else {
+    track(session);
+    if (state_ == RelocState::kRelocalising) result.lost_now = true;
+  }
+  result.state = state_;
+  if (state_ == RelocState::kLocalised) result.T_map_lidar = T_map_session_ * session.pose;
+  return result;
+}
+
+void Relocaliser::loseFix() {
+  state_ = RelocState::kRelocalising;
+  pending_.clear();
+  track_failures_ = 0;
+  last_query_travelled_ = -1e9;
+  ++stats_.lost;
+}
+
+void Relocaliser::relocalise(const PoseEstimate& session, Result& result) {
+  const bool due = travelled_ - last_query_travelled_ >= config_.query_distance ||
+                   static_cast<double>(session.utime - last_query_utime_) * 1e-6 >= config_.query_interval_s;
+  if (!due) return;
+  last_query_travelled_ = travelled_;
+  last_query_utime_ = session.utime;
+  const std::optional<Fix> fix = query(session, recent_.back().second);
+  pending_.erase(std::remove_if(pending_.begin(), pending_.end(),
+                                [&](const Fix& p) { return travelled_ - p.travelled > config_.consistency_window_m; }),
+                 pending_.end());
+  if (!fix) return;
+  int agreeing = 1;
+  bool any_disagree = false;
+  for (const Fix& p : pending_) {
+    if (consistent(p, *fix)) ++agreeing;
+    else any_disagree = true;
+  }
+  if (agreeing < config_.min_consistent_fixes) {
+    if (any_disagree) ++stats_.rejected_inconsistent;
+    pending_.push_back(*fix);
+    return;
+  }
+  T_map_session_ = orthonormal(bundle_.keyframes[static_cast<std::size_t>(fix->match)].pose * fix->T_match_query *
+                               session.pose.inverse());
+  state_ = RelocState::kLocalised;
+  pending_.clear();
+  track_failures_ = 0;
+  ++stats_.fixes;
+  result.fixed_now = true;
+}
+
+// The newest sweeps in the current sweep's frame, downsampled as a keyframe's cloud.
+CompactCloud Relocaliser::queryCloud(const Eigen::Isometry3d& session) const {
+  std::vector<Eigen::Vector3f> merged;
+  const Eigen::Isometry3d T_now_world = session.inverse();
+  for (const auto& [pose, points] : recent_) {
+    const Eigen::Isometry3f T = (T_now_world * pose).cast<float>();
+    for (const Eigen::Vector3f& p : points) merged.push_back(T * p);
+  }
+  return CompactCloud::encode(voxelDownsample(merged, loop_.keyframe_voxel), static_cast<float>(loop_.keyframe_cloud_step));
+}
+
+CandidateNeighbourhood Relocaliser::neighbourhood(int m) const {
+  CandidateNeighbourhood n;
+  const int last = static_cast<int>(bundle_.keyframes.size()) - 1;
+  const Eigen::Isometry3d T_m_map = bundle_.keyframes[static_cast<std::size_t>(m)].pose.inverse();
+  for (int j = std::max(0, m - config_.submap_neighbors); j <= std::min(last, m + config_.submap_neighbors); ++j) {
+    n.clouds.push_back(bundle_.keyframes[static_cast<std::size_t>(j)].cloud);
+    n.T_match_cloud.push_back(T_m_map * bundle_.keyframes[static_cast<std::size_t>(j)].pose);
+  }
+  return n;
+}
+
+// One query: Scan Context candidates, ICP verification, ambiguity test. The verified, unambiguous fit or none.
+std::optional<Relocaliser::Fix> Relocaliser::query(const PoseEstimate& session, const std::vector<Eigen::Vector3f>& cloud) {
+  ++stats_.queries;
+  const ScanContext context = keyframeScanContext(cloud, session.pose, loop_.level_scan_context, loop_.scan_context);
+  if (context.empty() || database_.size() == 0) return std::nullopt;
+  const CompactCloud compact = queryCloud(session.pose);
+  struct Tried {
+    Fix fix;
+    LoopVerification v;
+  };
+  std::vector<Tried> tried;
+  for (const ScanContextCandidate& c : database_.query(context, 0)) {
+    if (c.distance > loop_.max_scan_context_distance || static_cast<int>(tried.size()) >= config_.max_verifications) break;
+    const BundleKeyframe& match = bundle_.keyframes[static_cast<std::size_t>(c.index)];
+    const std::vector<Eigen::Isometry3d> seeds{scanContextSeed(session.pose, match.pose, c.yaw, loop_.level_scan_context)};
+    ++stats_.verified;
+    Tried t;
+    t.v = verifyCandidate(compact, neighbourhood(c.index), seeds, loop_.verifier);
+    t.fix = {c.index, t.v.T_match_query, session.pose, travelled_};
+    tried.push_back(t);
+  }
+  const auto mapPose = [this](const Fix& f) { return bundle_.keyframes[static_cast<std::size_t>(f.match)].pose * f.T_match_query; };
+  const Tried* best = nullptr;
+  for (const Tried& t : tried)
+    if (t.v.verdict == LoopVerdict::kAccepted && (!best || t.v.icp.inlier_ratio > best->v.icp.inlier_ratio)) best = &t;
+  if (!best) {
+    const bool degenerate = std::any_of(tried.begin(), tried.end(),
+                                        [](const Tried& t) { return t.v.verdict == LoopVerdict::kDegenerate; });
+    if (degenerate) ++stats_.rejected_degenerate;
+    else if (!tried.empty()) ++stats_.rejected_fit;
+    return std::nullopt;
+  }
+  const Eigen::Vector3d at = mapPose(best->fix).translation();
+  for (const Tried& t : tried) {
+    if (&t == best || t.v.seed < 0) continue;
+    const bool elsewhere = (mapPose(t.fix).translation() - at).norm() > config_.ambiguity_distance;
+    if (elsewhere && t.v.icp.inlier_ratio >= best->v.icp.inlier_ratio - config_.ambiguity_margin) {
+      ++stats_.rejected_ambiguous;
+      return std::nullopt;
+    }
+  }
+  return best->fix;
+}
+
+// The loop closer's pairwise cycle test: the two fits and the session's motion between the queries must close.
+bool Relocaliser::consistent(const Fix& a, const Fix& b) const {
+  const Eigen::Isometry3d T_ma_mb = bundle_.keyframes[static_cast<std::size_t>(a.match)].pose.inverse() *
+                                    bundle_.keyframes[static_cast<std::size_t>(b.match)].pose;
+  const Eigen::Isometry3d T_qa_qb = a.session.inverse() * b.session;
+  const double driven = std::abs(b.travelled - a.travelled);
+  const Matrix6d cov = driftCovariance(loop_, driven) + driftCovariance(loop_, translationNorm(T_ma_mb)) +
+                       2.0 * fitCovariance(loop_);
+  return pairChi2(a.T_match_query, b.T_match_query, T_ma_mb, T_qa_qb, cov) <= loop_.max_pair_chi2;
+}
+
+// Localised: verify the sweep against the bundle keyframes nearest its predicted map pose and refine the offset.
+void Relocaliser::track(const PoseEstimate& session) {
+  if (travelled_ - last_query_travelled_ < config_.track_distance) return;
+  last_query_travelled_ = travelled_;
+  const Eigen::Isometry3d predicted = T_map_session_ * session.pose;
+  int nearest = -1;
+  double best = 1e18;
+  for (std::size_t k = 0; k < bundle_.keyframes.size(); ++k) {
+    const double d = (bundle_.keyframes[k].pose.translation() - predicted.translation()).squaredNorm();
+    if (d < best) best = d, nearest = static_cast<int>(k);
+  }
+  bool ok = false;
+  if (nearest >= 0) {
+    const Eigen::Isometry3d& match = bundle_.keyframes[static_cast<std::size_t>(nearest)].pose;
+    const LoopVerification v = verifyCandidate(queryCloud(session.pose), neighbourhood(nearest), {match.inverse() * predicted},
+                                               loop_.verifier);
+    const Eigen::Isometry3d refined = match * v.T_match_query;
+    const bool small = translationNorm(predicted.inverse() * refined) <= config_.max_track_correction;
+    // A tight fit along a featureless stretch says the map still fits but not where along it: keep the pose.
+    if (v.verdict == LoopVerdict::kDegenerate && small) {
+      ++stats_.track_degenerate;
+      track_failures_ = 0;
+      return;
+    }
+    ok = v.verdict == LoopVerdict::kAccepted && small;
+    if (ok) T_map_session_ = orthonormal(refined * session.pose.inverse());
+  }
+  if (ok) {
+    ++stats_.track_verified;
+    track_failures_ = 0;
+  } else {
+    ++stats_.track_failed;
+    if (++track_failures_ >= config_.max_track_failures) loseFix();
+  }
+}
+
+}  // namespace adit

@@ -1,0 +1,120 @@
+// Relocalisation on a saved map (issue 18): a run that starts with no initial guess finds its pose in a map
+// bundle's frame, keeps it while it drives, and finds it again when lost.
+//
+// Relocalising: every reloc.query_distance of driving (or reloc.query_interval_s standing still) the current
+// sweep becomes a query keyframe; its Scan Context is searched among the bundle's keyframes and the best
+// candidates are verified by ICP against each candidate's neighbourhood at its map pose: the loop closer's own
+// steps (loop/place_match.hpp) and acceptance tests (tight fit, all 6 directions constrained). A verified fit
+// is then refused when ambiguous (a fit at another place within reloc.ambiguity_margin of its inlier ratio),
+// and becomes the fix only once reloc.min_consistent_fixes queries agree (the loop closer's pairwise cycle
+// test with the session's odometry between them). Roadways repeat: refusing is better than guessing.
+// Localised: the pose in the map is T_map_session * session pose, every sweep; every reloc.track_distance the
+// sweep is verified against the nearest bundle keyframes (seeded by that pose) and the offset refined. Lost
+// (back to relocalising) after reloc.max_track_failures failed verifications in a row, a registration failure
+// or a sensor stall longer than reloc.max_stall_s. The bundle is never changed and memory does not grow.
+#pragma once
+
+#include "core/config_table.hpp"
+#include "core/types.hpp"
+#include "loop/loop_closer.hpp"
+#include "loop/place_match.hpp"
+#include "map/map_bundle.hpp"
+
+#include <deque>
+#include <optional>
+#include <vector>
+
+namespace adit {
+
+struct RelocaliserConfig {
+  int candidates = 25;           // ring-key neighbours ranked by Scan Context distance per query
+  int max_verifications = 4;     // best candidates verified by ICP per query
+  // Sweeps merged (at their session poses) into the cloud ICP aligns: a 16-beam sweep leaves gaps between its
+  // rings that a few consecutive sweeps fill, which constrains the fit along a roadway of arches and bolts.
+  int query_sweeps = 5;
+  // Bundle keyframes each side of a candidate in its submap (the loop closer uses loop.verifier.submap_neighbors,
+  // 5): a straight roadway constrains a fit along its axis only through what lies tens of metres away (niches,
+  // equipment, junctions), which a single sweep sees and a +-5 m submap does not hold.
+  int submap_neighbors = 20;
+  double query_distance = 0.5;   // m driven between two queries while relocalising
+  double query_interval_s = 1.0; // ... or this much sensor time
+  double ambiguity_distance = 3.0;  // m: two fits farther apart than this are different places
+  double ambiguity_margin = 0.15;   // a fit elsewhere with an inlier ratio within this of the best: ambiguous
+  int min_consistent_fixes = 2;     // verified, unambiguous queries that must agree before the first fix
+  double consistency_window_m = 15.0;  // pending fixes older than this much driving are dropped
+  double track_distance = 1.0;      // m driven between tracking verifications once localised
+  double max_track_correction = 1.0;  // m: a tracking fit moving the pose more than this is refused
+  int max_track_failures = 8;       // failed tracking verifications in a row: lost
+  double max_stall_s = 1.0;         // a gap in the input longer than this: lost
+};
+
+const ConfigTable<RelocaliserConfig>& relocaliserConfigTable();
+
+enum class RelocState { kRelocalising, kLocalised };
+const char* toString(RelocState state);
+
+struct RelocStats {
+  int queries = 0;
+  int verified = 0;             // candidates verified by ICP
+  int rejected_fit = 0;         // no candidate fitted tightly
+  int rejected_degenerate = 0;  // the best fit left a direction unconstrained (a featureless stretch)
+  int rejected_ambiguous = 0;   // a fit elsewhere nearly as good
+  int rejected_inconsistent = 0;// disagreed with the pending fixes
+  int fixes = 0;                // times localised (first fix and each relocalisation after being lost)
+  int lost = 0;
+  int track_verified = 0, track_failed = 0;
+  int track_degenerate = 0;     // fits but constrains too few directions: kept, not a failure
+};
+
+class Relocaliser {
+ public:
+  Relocaliser(MapBundle bundle, const LoopCloserConfig& loop, const RelocaliserConfig& config);
+
+  struct Result {
+    RelocState state = RelocState::kRelocalising;
+    bool fixed_now = false;  // this sweep gave the fix
+    bool lost_now = false;
+    std::optional<Eigen::Isometry3d> T_map_lidar;  // only when localised
+  };
+  // session: the run's own pose (mapper output) of the sweep; cloud: its deskewed points, lidar frame.
+  Result process(const PoseEstimate& session, const std::vector<Eigen::Vector3f>& cloud, bool registration_failed);
+
+  RelocState state() const { return state_; }
+  const RelocStats& stats() const { return stats_; }
+  const MapBundle& bundle() const { return bundle_; }
+
+ private:
+  struct Fix {
+    int match = -1;                 // bundle keyframe
+    Eigen::Isometry3d T_match_query = Eigen::Isometry3d::Identity();
+    Eigen::Isometry3d session = Eigen::Isometry3d::Identity();  // query's session pose
+    double travelled = 0.0;         // session distance driven at the query
+  };
+  void relocalise(const PoseEstimate& session, Result& result);
+  void track(const PoseEstimate& session);
+  std::optional<Fix> query(const PoseEstimate& session, const std::vector<Eigen::Vector3f>& cloud);
+  bool consistent(const Fix& a, const Fix& b) const;
+  CandidateNeighbourhood neighbourhood(int match) const;
+  CompactCloud queryCloud(const Eigen::Isometry3d& session) const;
+  void loseFix();
+
+  MapBundle bundle_;
+  LoopCloserConfig loop_;
+  RelocaliserConfig config_;
+  ScanContextDatabase database_;
+  RelocState state_ = RelocState::kRelocalising;
+  Eigen::Isometry3d T_map_session_ = Eigen::Isometry3d::Identity();
+  std::vector<Fix> pending_;
+  RelocStats stats_;
+  // Session motion bookkeeping.
+  bool have_last_ = false;
+  Eigen::Isometry3d last_pose_ = Eigen::Isometry3d::Identity();
+  std::int64_t last_utime_ = 0;
+  double travelled_ = 0.0;
+  double last_query_travelled_ = -1e9;
+  std::int64_t last_query_utime_ = 0;
+  int track_failures_ = 0;
+  std::deque<std::pair<Eigen::Isometry3d, std::vector<Eigen::Vector3f>>> recent_;  // newest query_sweeps sweeps
+};
+
+}  // namespace adit

@@ -1,0 +1,114 @@
+#include "nodes/relocaliser_node.hpp"
+
+#include "eval/trajectory_io.hpp"
+#include "io/atomic_file.hpp"
+#include "map/relocaliser.hpp"
+#include "msg/convert.hpp"
+#include "nodes/node_config.hpp"
+#include "nodes/products.hpp"
+#include "nodes/registry.hpp"
+
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include <chrono>
+#include <filesystem>
+#include <optional>
+
+namespace adit::nodes {
+namespace {
+
+class RelocaliserNode : public runtime::Node, public WritesProducts {
+ public:
+  explicit RelocaliserNode(const Config& config) : Node("relocaliser") {
+    subscribe<adit::odometry_t>("mapped", "ODOM_MAPPED", [this](const adit::odometry_t& m) { onMapped(m); });
+    advertise("pose", "POSE_IN_MAP");
+    const RelocNodeConfig node = relocNodeConfigTable().read(config);
+    if (node.prior_map.empty()) return;  // no bundle asked for: the run maps from scratch
+    try {
+      MapBundle bundle = loadMapBundle(node.prior_map);
+      const std::string mismatch = bundleSensorMismatch(bundle.summary, pipelineConfigKeys(config));
+      if (!mismatch.empty()) throw BundleError(node.prior_map + ": " + mismatch);
+      relocaliser_.emplace(std::move(bundle), loopCloserConfigFrom(config), relocaliserConfigTable().read(config));
+      spdlog::info("[relocaliser] map bundle {}: {} keyframes, {:.0f} m of roadway", node.prior_map,
+                   relocaliser_->bundle().summary.keyframes, relocaliser_->bundle().summary.roadway_length_m);
+    } catch (const BundleError& e) {
+      reportError("bundle_refused", std::string(e.what()) + "; mapping from scratch");
+    }
+  }
+
+  std::string state() const override {
+    return relocaliser_ ? toString(relocaliser_->state()) : "mapping_from_scratch";
+  }
+
+  std::vector<std::string> writeProducts(const std::string& out_dir) override {
+    namespace fs = std::filesystem;
+    const std::string trajectory = (fs::path(out_dir) / "map_trajectory.tum").string();
+    const std::string summary = (fs::path(out_dir) / "relocalisation.json").string();
+    eval::writeTum(trajectory, in_map_);
+    io::writeFileAtomically(summary, summaryJson());
+    return {trajectory, summary};
+  }
+
+ private:
+  void onMapped(const adit::odometry_t& m) {
+    if (!relocaliser_) return;
+    const PoseEstimate session = msg::fromMessage(m);
+    if (first_utime_ < 0) first_utime_ = session.utime;
+    std::vector<Eigen::Vector3f> cloud;
+    for (const LidarPoint& p : msg::featuresOf(m).cloud.points)
+      if (p.p.allFinite()) cloud.push_back(p.p);
+    // Wall time until the first fix: measurement only (relocalisation.json), never part of a decision.
+    const auto start = std::chrono::steady_clock::now();
+    const Relocaliser::Result r =
+        relocaliser_->process(session, cloud, (m.flags & adit::odometry_t::FLAG_REGISTRATION_FAILED) != 0);
+    if (!first_fix_) compute_ms_ += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    if (r.fixed_now) {
+      if (!first_fix_) first_fix_ = session.utime;
+      spdlog::info("[relocaliser] localised in the map after {:.1f} s of sensor time",
+                   static_cast<double>(session.utime - first_utime_) * 1e-6);
+    }
+    if (r.lost_now) spdlog::warn("[relocaliser] lost at {:.1f} s: relocalising", static_cast<double>(session.utime - first_utime_) * 1e-6);
+    if (r.T_map_lidar) {
+      in_map_.push_back({session.utime, *r.T_map_lidar});
+      adit::odometry_t out = msg::toMessage(PoseEstimate{session.utime, *r.T_map_lidar}, nullptr);
+      out.header = msg::makeHeader(session.utime, "map");
+      publish("pose", out);
+    }
+    const RelocStats& s = relocaliser_->stats();
+    setCount("queries", s.queries);
+    setCount("fixes", s.fixes);
+    setCount("lost", s.lost);
+    setCount("rejected_fit", s.rejected_fit);
+    setCount("rejected_degenerate", s.rejected_degenerate);
+    setCount("rejected_ambiguous", s.rejected_ambiguous);
+    setCount("rejected_inconsistent", s.rejected_inconsistent);
+    setCount("track_failed", s.track_failed);
+  }
+
+  std::string summaryJson() const {
+    const RelocStats s = relocaliser_ ? relocaliser_->stats() : RelocStats{};
+    const double fix_s = first_fix_ ? static_cast<double>(*first_fix_ - first_utime_) * 1e-6 : -1.0;
+    return fmt::format(
+        "{{\n  \"state\": \"{}\",\n  \"first_fix_sensor_s\": {:.3f},\n  \"first_fix_utime\": {},\n"
+        "  \"first_fix_compute_ms\": {:.1f},\n  \"poses_in_map\": {},\n  \"queries\": {},\n  \"fixes\": {},\n"
+        "  \"lost\": {},\n  \"rejected_fit\": {},\n  \"rejected_degenerate\": {},\n  \"rejected_ambiguous\": {},\n  \"rejected_inconsistent\": {},\n"
+        "  \"track_verified\": {},\n  \"track_failed\": {},\n  \"track_degenerate\": {}\n}}\n",
+        state(), fix_s, first_fix_.value_or(0), compute_ms_, in_map_.size(), s.queries, s.fixes, s.lost, s.rejected_fit, s.rejected_degenerate,
+        s.rejected_ambiguous, s.rejected_inconsistent, s.track_verified, s.track_failed, s.track_degenerate);
+  }
+
+  std::optional<Relocaliser> relocaliser_;
+  Trajectory in_map_;
+  std::int64_t first_utime_ = -1;
+  std::optional<std::int64_t> first_fix_;
+  double compute_ms_ = 0.0;  // wall time of the sweeps up to the first fix (varies run to run)
+};
+
+}  // namespace
+
+std::unique_ptr<runtime::Node> makeRelocaliserNode(const Config& config) {
+  return std::make_unique<RelocaliserNode>(config);
+}
+
+}  // namespace adit::nodes
