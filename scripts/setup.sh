@@ -15,7 +15,7 @@ PACKAGES=(
   openjdk-17-jdk-headless openjdk-17-jre libjchart2d-java
   python3-numpy python3-matplotlib
   libssl-dev libbz2-dev liblz4-dev libzstd-dev
-  iproute2 util-linux nftables
+  iproute2 util-linux nftables curl
   nodejs npm chromium
 )
 

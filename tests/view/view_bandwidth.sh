@@ -21,12 +21,7 @@ YAML
 "$bin"/adit view --log run.lcmlog --log out/output.lcmlog --port 0 --paused --duration $((duration + 60)) > view.log 2>&1 &
 view=$!
 trap 'kill $view 2>/dev/null || true' EXIT
-port=""
-for _ in $(seq 100); do
-  port=$(sed -n 's|.*http://127.0.0.1:\([0-9]*\)/.*|\1|p' view.log | head -1)
-  [ -n "$port" ] && break
-  sleep 0.2
-done
+port=$(view_port view.log 100)
 node js/view_page.js "http://127.0.0.1:$port/" bandwidth.png 60 "$((duration - 2))" > bandwidth.json || true
 node -e '
 const s = require(process.argv[1]);

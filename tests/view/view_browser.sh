@@ -24,13 +24,7 @@ poses=$("$bin"/adit info out/output.lcmlog | awk '$1 == "ODOM_MAPPED" { print $2
   --duration 120 > view.log 2>&1 &
 view=$!
 trap 'kill $view 2>/dev/null || true' EXIT
-port=""
-for _ in $(seq 50); do
-  port=$(sed -n 's|.*http://127.0.0.1:\([0-9]*\)/.*|\1|p' view.log | head -1)
-  [ -n "$port" ] && break
-  sleep 0.2
-done
-[ -n "$port" ] || { echo "FAIL: adit view did not start"; cat view.log; exit 1; }
+port=$(view_port view.log 50)
 code=$(curl -s -o /dev/null -w '%{http_code}' "http://127.0.0.1:$port/no-such-file.js")
 [ "$code" = 404 ] || { echo "FAIL: unknown path gave HTTP $code"; exit 1; }
 

@@ -16,13 +16,7 @@ rm -rf out
   --duration 60 > view.log 2>&1 &
 view=$!
 trap 'kill $view 2>/dev/null || true' EXIT
-port=""
-for _ in $(seq 50); do
-  port=$(sed -n 's|.*http://127.0.0.1:\([0-9]*\)/.*|\1|p' view.log | head -1)
-  [ -n "$port" ] && break
-  sleep 0.1
-done
-[ -n "$port" ] || { echo "FAIL: adit view did not start"; cat view.log; exit 1; }
+port=$(view_port view.log 50)
 node ../js/foxglove_ws.js "ws://127.0.0.1:$port/ws" 22 > foxglove.json
 node -e '
 const s = require(process.argv[1]), t = s.topics;

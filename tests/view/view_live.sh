@@ -11,8 +11,8 @@ bin=$1 src=$2 work=$3
 chromium=${CHROMIUM:-/usr/bin/chromium}
 [ -x "$chromium" ] || { echo "SKIP: no chromium ($chromium; scripts/setup.sh installs Debian's)"; exit 77; }
 [ -f "$bin"/../share/adit/view/three.module.js ] || { echo "SKIP: three.js was not installed into the build"; exit 77; }
+source "$src"/tests/view/npm_tools.sh
 if [ -z "${ADIT_IN_NETNS:-}" ]; then
-  source "$src"/tests/view/npm_tools.sh
   npm_tools "$src" "$work"/../js  # with the network; the namespace has none
   exec "$src"/tests/integration/netns.sh "$0" "$@"
 fi
@@ -25,13 +25,7 @@ ADIT_LCM_URL="$url" "$bin"/adit launch "$src"/launch/sim.launch.yaml --set DURAT
   --log-dir "$work"/runs > launch.log 2>&1 &
 launch=$!
 trap 'kill $view $launch 2>/dev/null || true' EXIT
-port=""
-for _ in $(seq 50); do
-  port=$(sed -n 's|.*http://127.0.0.1:\([0-9]*\)/.*|\1|p' view.log | head -1)
-  [ -n "$port" ] && break
-  sleep 0.2
-done
-[ -n "$port" ] || { echo "FAIL: adit view did not start"; cat view.log; exit 1; }
+port=$(view_port view.log 50)
 ADIT_SAVE_MAP=live_test,../escape node ../js/view_page.js "http://127.0.0.1:$port/" view.png 90 > state.json
 wait $launch || true
 node -e '
