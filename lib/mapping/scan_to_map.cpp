@@ -1,5 +1,7 @@
 #include "mapping/scan_to_map.hpp"
 
+#include <algorithm>
+
 #include "mapping/downsample.hpp"
 #include "registration/feature_fit.hpp"
 #include "odometry/motion_compensation.hpp"
@@ -31,6 +33,7 @@ MapperConfig aloamMapperConfig() {
   m.registration.degeneracy_prior = false;
   m.compensate_raw_sweeps = false;
   m.registration.max_solver_iterations = 4;
+  m.plane_through_nearest = false;
   return m;
 }
 
@@ -48,6 +51,7 @@ const ConfigTable<MapperConfig>& mapperConfigTable() {
      .add("max_neighbour_distance_m", &M::max_neighbour_distance_m, above(0), "m", "farthest neighbour accepted (A-LOAM: 1)")
      .add("line_eigen_ratio", &M::line_eigen_ratio, atLeast(1), "", "edge if the largest eigenvalue exceeds ratio * the second (A-LOAM: 3)")
      .add("plane_max_point_distance_m", &M::plane_max_point_distance_m, above(0), "m", "a plane is rejected if a neighbour is farther (A-LOAM: 0.2)")
+     .add("plane_through_nearest", &M::plane_through_nearest, anyValue(), "", "a surface match's plane passes through the nearest map point, not the neighbours' centroid (A-LOAM: false)")
      .add("local_map_radius_m", &M::local_map_radius_m, above(0), "m", "map points farther from the robot are dropped (bounds memory)")
      .add("global_map_resolution_m", &M::global_map_resolution_m, between(0.01, 100), "m", "resolution of the saved global map")
      .add("global_map_max_range_m", &M::global_map_max_range_m, above(0), "m", "range of the sweep points folded into the global map")
@@ -84,8 +88,17 @@ Correspondences ScanToMapMapper::match(const std::vector<Eigen::Vector3d>& corne
     thread_local std::vector<Eigen::Vector3d> near;
     surf_map_.nearest(T * surfs[i], k, config_.max_neighbour_distance_m, near);
     if (static_cast<int>(near.size()) < k) return;
-    if (const auto plane = fitPlane(near, config_.plane_max_point_distance_m))
-      planes.push_back({surfs[i], plane->normal, plane->offset});
+    const auto plane = fitPlane(near, config_.plane_max_point_distance_m);
+    if (!plane) return;
+    double offset = plane->offset;
+    if (config_.plane_through_nearest) {
+      const Eigen::Vector3d q = T * surfs[i];
+      const auto nearest = std::min_element(near.begin(), near.end(), [&q](const auto& a, const auto& b) {
+        return (a - q).squaredNorm() < (b - q).squaredNorm();
+      });
+      offset = -plane->normal.dot(*nearest);
+    }
+    planes.push_back({surfs[i], plane->normal, offset});
   };
   return matchInChunks(pool_.get(), corners.size(), surfs.size(), add_line, add_plane);
 }
