@@ -8,6 +8,7 @@
 #include "commands.hpp"
 #include "msg/encode.hpp"
 #include "runtime/command_auth.hpp"
+#include "runtime/command_message.hpp"
 #include "runtime/process.hpp"
 #include "runtime/run_folder.hpp"
 
@@ -29,16 +30,6 @@ struct CommandArgs {
   std::string new_key_path;
 };
 
-// Signs with the sender's wall clock as the counter: the receiver accepts it within its clock window and
-// only above the last counter it accepted.
-void sign(adit::command_t& c, const std::string& channel, const std::string& key_path) {
-  const adit::runtime::CommandKey key = adit::runtime::readCommandKey(key_path);
-  c.counter = adit::runtime::wallUtime();
-  const adit::runtime::CommandMac mac = adit::runtime::commandMac(key, channel, c.command, c.argument, c.counter);
-  c.mac.assign(mac.begin(), mac.end());
-  c.mac_size = static_cast<std::int32_t>(c.mac.size());
-}
-
 void publishSave(const CommandArgs& a) {
   if (!a.name.empty()) {
     const std::string problem = adit::runtime::plainFileNameProblem(a.name);
@@ -46,13 +37,9 @@ void publishSave(const CommandArgs& a) {
   }
   lcm::LCM lcm(a.lcm_url);
   if (!lcm.good()) throw std::runtime_error("cannot open LCM '" + a.lcm_url + "'");
-  adit::command_t c{};
-  c.header.utime = adit::runtime::wallUtime();
-  c.header.seq = 0;
-  c.command = a.command;
-  c.argument = a.name;
   const std::string key_path = adit::runtime::commandKeyPath(a.key_path);
-  if (!key_path.empty()) sign(c, a.channel, key_path);
+  const adit::command_t c =
+      adit::runtime::makeCommand(a.channel, a.command, a.name, key_path, adit::runtime::wallUtime());
   const std::vector<std::uint8_t> bytes = adit::msg::encode(c);
   if (lcm.publish(a.channel, bytes.data(), static_cast<unsigned int>(bytes.size())) != 0)
     throw std::runtime_error("cannot publish on " + a.channel);

@@ -5,6 +5,8 @@
 
 #include "foxglove/foxglove_ws.hpp"
 #include "msg/encode.hpp"
+#include "runtime/command_auth.hpp"
+#include "runtime/command_message.hpp"
 #include "runtime/process.hpp"
 #include "runtime/run_folder.hpp"
 #include "view/log_player.hpp"
@@ -31,6 +33,7 @@ struct ViewArgs {
   double speed = 1.0;
   bool paused = false;
   bool allow_commands = false;
+  std::string key_path;  // signs the page's commands (--command-key, else $ADIT_COMMAND_KEY)
   double duration_s = 0;
   adit::view::ViewOptions view;
   bool foxglove = false;
@@ -44,7 +47,8 @@ void onMessage(const lcm::ReceiveBuffer* rbuf, const std::string& channel, adit:
 }
 
 // save_map NAME from the page, only with --allow-commands and only a plain file name (the receiver's rule).
-std::string saveMap(lcm::LCM* lcm, const std::string& text) {
+// Signed with the key at key_path when there is one (processes started with a command key obey only those).
+std::string saveMap(lcm::LCM* lcm, const std::string& text, const std::string& key_path) {
   std::istringstream in(text);
   std::string verb, name;
   in >> verb >> name;
@@ -52,22 +56,21 @@ std::string saveMap(lcm::LCM* lcm, const std::string& text) {
   if (!name.empty())
     if (const std::string problem = adit::runtime::plainFileNameProblem(name); !problem.empty())
       return "save_map '" + name + "': " + problem;
-  adit::command_t c{};
-  c.header.utime = adit::runtime::wallUtime();
-  c.command = "save_map";
-  c.argument = name;
+  const adit::command_t c =
+      adit::runtime::makeCommand("MAPPER_COMMAND", "save_map", name, key_path, adit::runtime::wallUtime());
   const auto bytes = adit::msg::encode(c);
   lcm->publish("MAPPER_COMMAND", bytes.data(), static_cast<unsigned int>(bytes.size()));
   return "";
 }
 
 void handleCommands(adit::view::WebServer& server, adit::view::RunConsumer& consumer, adit::view::LogPlayer* player,
-                    adit::foxglove::FoxgloveWs* foxglove, lcm::LCM* lcm, bool allow_commands) {
+                    adit::foxglove::FoxgloveWs* foxglove, lcm::LCM* lcm, bool allow_commands,
+                    const std::string& key_path) {
   for (const auto& [client, text] : server.takeMessages()) {
     if (foxglove && foxglove->message(client, text)) continue;  // a Foxglove client's subscriptions
     if (player && player->command(text, consumer)) continue;   // playback of the viewer's own log
     if (allow_commands && text.rfind("save_map", 0) == 0) {
-      const std::string error = saveMap(lcm, text);
+      const std::string error = saveMap(lcm, text, key_path);
       if (error.empty()) {
         spdlog::info("client {}: sent {}", client, text);
       } else {
@@ -111,6 +114,12 @@ void runView(const ViewArgs& a) {
   spdlog::info("adit view on http://{}:{}/ ({}{})", a.bind, server.port(),
                player ? fmt::format("{} log(s), {:.1f} s", a.logs.size(), player->duration()) : "live LCM",
                a.bind == "127.0.0.1" ? "; this computer only: --bind 0.0.0.0 serves the LAN" : "; read-only");
+  // The key is read now, so a bad key file is an error at start, not when the operator presses save.
+  const std::string key_path = a.allow_commands ? adit::runtime::commandKeyPath(a.key_path) : std::string();
+  if (!key_path.empty()) {
+    adit::runtime::readCommandKey(key_path);
+    spdlog::info("the page's commands are signed with {}", key_path);
+  }
   adit::runtime::installStopHandlers();
   const std::string commands_json = a.allow_commands ? "\"commands_allowed\":true" : "";
   const auto start = Clock::now();
@@ -129,7 +138,7 @@ void runView(const ViewArgs& a) {
       if (foxglove) foxglove->forget(client);
     }
     if (foxglove) foxglove->tick();
-    handleCommands(server, consumers, player.get(), foxglove.get(), lcm.get(), a.allow_commands);
+    handleCommands(server, consumers, player.get(), foxglove.get(), lcm.get(), a.allow_commands, key_path);
     session.tick(elapsed, player ? player->infoJson() : commands_json);
     if (now - last_report >= std::chrono::seconds(10)) {
       const auto& c = server.counters();
@@ -163,6 +172,8 @@ void registerViewCommand(CLI::App& app) {
   cmd->add_option("--speed", a->speed, "With --log: playback speed")->check(CLI::Range(0.1, 50.0))->needs(log)->capture_default_str();
   cmd->add_flag("--paused", a->paused, "With --log: start paused")->needs(log);
   cmd->add_flag("--allow-commands", a->allow_commands, "Let the page send save_map NAME (a plain file name) on MAPPER_COMMAND");
+  cmd->add_option("--command-key", a->key_path,
+                  "With --allow-commands: sign them with this key file (default: $ADIT_COMMAND_KEY, else unsigned)");
   cmd->add_option("--sweep-points", a->view.sweep_points, "Points of a sweep sent to the page")->capture_default_str();
   cmd->add_option("--sweep-rate", a->view.sweep_rate_hz, "Sweeps sent per second at most")->check(CLI::Range(0.1, 50.0))->capture_default_str();
   cmd->add_option("--web-root", a->web_root, "Folder of the page (default: <bin>/../share/adit/view)");

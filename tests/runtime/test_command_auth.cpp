@@ -1,6 +1,7 @@
 // Signed commands: the MAC is the documented HMAC-SHA256 (a vector computed independently), and the gate
 // obeys only a command signed with the key, not altered, not replayed, and within the clock window.
 #include "runtime/command_auth.hpp"
+#include "runtime/command_message.hpp"
 
 #include <fmt/format.h>
 #include <gtest/gtest.h>
@@ -83,6 +84,26 @@ TEST(CommandAuth, GateObeysOnlyFreshAuthenticCommands) {
   EXPECT_EQ(gate.check("MAPPER_COMMAND", "save_map", "a", late, macOf(testKey(), "a", late), late + 1000),
             CommandVerdict::Authentic);
   EXPECT_STREQ(counterName(CommandVerdict::Replayed), "command_replayed");
+}
+
+// What `adit command` and `adit view --allow-commands` send: signed with the key file when there is one.
+TEST(CommandAuth, SendersBuildCommandsTheGateObeys) {
+  const fs::path dir = freshDir("sender");
+  const fs::path key = dir / "operator.key";
+  writeNewCommandKey(key.string());
+  CommandGate gate(readCommandKey(key.string()));
+  const adit::command_t signed_command = makeCommand("MAPPER_COMMAND", "save_map", "shift_2", key.string(), kNow);
+  EXPECT_EQ(signed_command.command, "save_map");
+  EXPECT_EQ(signed_command.argument, "shift_2");
+  EXPECT_EQ(signed_command.mac_size, 32);
+  EXPECT_EQ(gate.check("MAPPER_COMMAND", signed_command.command, signed_command.argument, signed_command.counter,
+                       signed_command.mac, kNow),
+            CommandVerdict::Authentic);
+  const adit::command_t plain = makeCommand("MAPPER_COMMAND", "save_map", "shift_3", "", kNow + 1);
+  EXPECT_EQ(plain.mac_size, 0);
+  EXPECT_EQ(gate.check("MAPPER_COMMAND", plain.command, plain.argument, plain.counter, plain.mac, kNow + 1),
+            CommandVerdict::Unsigned);
+  EXPECT_THROW(makeCommand("MAPPER_COMMAND", "save_map", "x", (dir / "missing.key").string(), kNow), std::runtime_error);
 }
 
 TEST(CommandAuth, KeyFilesMustBePrivateHexAndAreNeverOverwritten) {
