@@ -1,7 +1,5 @@
 #include "mapping/scan_to_map.hpp"
 
-#include <algorithm>
-
 #include "mapping/downsample.hpp"
 #include "registration/feature_fit.hpp"
 #include "odometry/motion_compensation.hpp"
@@ -90,14 +88,8 @@ Correspondences ScanToMapMapper::match(const std::vector<Eigen::Vector3d>& corne
     if (static_cast<int>(near.size()) < k) return;
     const auto plane = fitPlane(near, config_.plane_max_point_distance_m);
     if (!plane) return;
-    double offset = plane->offset;
-    if (config_.plane_through_nearest) {
-      const Eigen::Vector3d q = T * surfs[i];
-      const auto nearest = std::min_element(near.begin(), near.end(), [&q](const auto& a, const auto& b) {
-        return (a - q).squaredNorm() < (b - q).squaredNorm();
-      });
-      offset = -plane->normal.dot(*nearest);
-    }
+    // VoxelMap::nearest lists the neighbours nearest first.
+    const double offset = config_.plane_through_nearest ? -plane->normal.dot(near.front()) : plane->offset;
     planes.push_back({surfs[i], plane->normal, offset});
   };
   return matchInChunks(pool_.get(), corners.size(), surfs.size(), add_line, add_plane);
