@@ -16,8 +16,11 @@ PACKAGES=(
   python3-numpy python3-matplotlib
   libssl-dev libbz2-dev liblz4-dev libzstd-dev
   iproute2 util-linux nftables curl
-  nodejs npm chromium
 )
+# Only the browser and MCAP tests use these (they skip without them). They are checked by command, not by
+# package: Node.js from another vendor (NodeSource's nodejs bundles npm) conflicts with Debian's npm package, and
+# a tool that is already on the PATH is good enough. A failed install is a warning, never a failed setup.
+OPTIONAL_TOOLS=(node:nodejs npm:npm chromium:chromium)
 
 missing=()
 for p in "${PACKAGES[@]}"; do
@@ -34,6 +37,18 @@ if ((${#missing[@]})); then
   export DEBIAN_FRONTEND=noninteractive
   apt-get update -qq
   apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+fi
+
+optional=()
+for entry in "${OPTIONAL_TOOLS[@]}"; do
+  command -v "${entry%%:*}" >/dev/null 2>&1 || optional+=("${entry#*:}")
+done
+if ((${#optional[@]})) && [ "$(id -u)" -eq 0 ]; then
+  echo "setup: installing optional test tool package(s): ${optional[*]}"
+  export DEBIAN_FRONTEND=noninteractive
+  ((${#missing[@]})) || apt-get update -qq
+  apt-get install -y -qq --no-install-recommends "${optional[@]}" >/dev/null ||
+    echo "setup: warning: could not install ${optional[*]}; the browser and MCAP tests will be skipped" >&2
 fi
 
 [ "${1:-}" = "--no-build" ] && exit 0
