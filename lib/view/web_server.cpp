@@ -1,12 +1,10 @@
 #include "view/web_server.hpp"
 
-#include "core/base64.hpp"
 
 #include <arpa/inet.h>
 #include <fcntl.h>
 #include <netinet/in.h>
 #include <netinet/tcp.h>
-#include <openssl/evp.h>
 #include <poll.h>
 #include <sys/socket.h>
 #include <unistd.h>
@@ -21,29 +19,11 @@
 namespace adit::view {
 namespace {
 
-constexpr std::size_t kMaxRequestBytes = 16384;
-
 struct Outgoing {
   std::string bytes;
   int tag = -1;
   bool frame = false;  // a WebSocket frame (counted), not an HTTP response
 };
-
-std::string lower(std::string s) {
-  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return s;
-}
-
-std::string trim(const std::string& s) {
-  const auto b = s.find_first_not_of(" \t"), e = s.find_last_not_of(" \t\r");
-  return b == std::string::npos ? "" : s.substr(b, e - b + 1);
-}
-
-// A file name the server may serve: letters, digits, '.', '-', '_', not starting with '.'.
-bool plainName(const std::string& name) {
-  if (name.empty() || name.size() > 64 || name[0] == '.') return false;
-  return std::all_of(name.begin(), name.end(), [](unsigned char c) { return std::isalnum(c) || c == '.' || c == '-' || c == '_'; });
-}
 
 std::string contentType(const std::string& name) {
   const auto dot = name.rfind('.');
@@ -71,43 +51,18 @@ void setNonBlocking(int fd) { ::fcntl(fd, F_SETFL, ::fcntl(fd, F_GETFL, 0) | O_N
 }  // namespace
 
 struct WebServer::Connection {
+  explicit Connection(std::size_t max_message) : frames(max_message) {}
   int fd = -1;
   int client = 0;  // > 0 once a WebSocket
   std::string subprotocol;
-  bool close_after_write = false;
+  bool close_after_write = false;  // answered for the last time: what the client sends now is ignored
   std::string in;
-  std::string fragments;  // a fragmented client message so far
+  ClientFrameReader frames;
   std::deque<Outgoing> out;
   std::size_t out_offset = 0;  // bytes of out.front() already sent
   std::size_t queued_bytes = 0;
   std::int64_t bytes_sent = 0;
 };
-
-std::string webSocketAccept(const std::string& key) {
-  const std::string text = key + "258EAFA5-E914-47DA-95CA-C5AB0DC85B11";
-  unsigned char digest[EVP_MAX_MD_SIZE];
-  unsigned int length = 0;
-  if (EVP_Digest(text.data(), text.size(), digest, &length, EVP_sha1(), nullptr) != 1)
-    throw std::runtime_error("SHA-1 failed");
-  return base64(std::string(reinterpret_cast<const char*>(digest), length));
-}
-
-std::string webSocketFrame(const std::string& payload, int opcode) {
-  std::string f;
-  f += static_cast<char>(0x80 | (opcode & 0x0F));
-  const std::uint64_t n = payload.size();
-  if (n < 126) {
-    f += static_cast<char>(n);
-  } else if (n <= 0xFFFF) {
-    f += static_cast<char>(126);
-    f += static_cast<char>((n >> 8) & 0xFF);
-    f += static_cast<char>(n & 0xFF);
-  } else {
-    f += static_cast<char>(127);
-    for (int i = 7; i >= 0; --i) f += static_cast<char>((n >> (8 * i)) & 0xFF);
-  }
-  return f + payload;
-}
 
 WebServer::WebServer(WebServerOptions options) : options_(std::move(options)) {
   listen_fd_ = ::socket(AF_INET, SOCK_STREAM, 0);
@@ -171,7 +126,7 @@ void WebServer::accept() {
     setNonBlocking(fd);
     const int one = 1;
     ::setsockopt(fd, IPPROTO_TCP, TCP_NODELAY, &one, sizeof(one));
-    auto c = std::make_unique<Connection>();
+    auto c = std::make_unique<Connection>(options_.max_message_bytes);
     c->fd = fd;
     connections_[fd] = std::move(c);
   }
@@ -184,6 +139,7 @@ void WebServer::readFrom(Connection& c) {
     if (n == 0 || (errno != EAGAIN && errno != EWOULDBLOCK)) close(c.fd);
     return;
   }
+  if (c.close_after_write) return;  // answered for the last time (an error, a close): input is dropped
   c.in.append(buf, static_cast<std::size_t>(n));
   const int fd = c.fd;
   if (c.client == 0) handleHttp(c);
@@ -195,103 +151,66 @@ void WebServer::respond(Connection& c, int status, const std::string& type, cons
   r << "HTTP/1.1 " << status << ' ' << statusText(status) << "\r\nContent-Type: " << type
     << "\r\nContent-Length: " << body.size() << "\r\nCache-Control: no-cache\r\nConnection: close\r\n\r\n" << body;
   c.close_after_write = true;
+  c.in.clear();
   queue(c, r.str(), -1, false);
 }
 
 void WebServer::handleHttp(Connection& c) {
-  const auto end = c.in.find("\r\n\r\n");
-  if (end == std::string::npos) {
-    if (c.in.size() > kMaxRequestBytes) {
-      ++counters_.bad_requests;
-      respond(c, 400, "text/plain", "request too large\n");
-    }
-    return;
+  HttpRequest request;
+  const Parse parsed = takeHttpRequest(c.in, request);
+  if (parsed == Parse::kIncomplete) return;
+  if (parsed == Parse::kBad) {
+    ++counters_.bad_requests;
+    return respond(c, 400, "text/plain", "request too large\n");
   }
   ++counters_.http_requests;
-  std::istringstream request(c.in.substr(0, end + 2));
-  c.in.erase(0, end + 4);
-  std::string line, method, path, version;
-  std::getline(request, line);
-  std::istringstream(line) >> method >> path >> version;
-  std::map<std::string, std::string> headers;
-  while (std::getline(request, line)) {
-    const auto colon = line.find(':');
-    if (colon != std::string::npos) headers[lower(trim(line.substr(0, colon)))] = trim(line.substr(colon + 1));
-  }
-  if (method != "GET" || version.rfind("HTTP/1.", 0) != 0) {
-    ++counters_.bad_requests;
-    return respond(c, method.empty() ? 400 : 405, "text/plain", "only GET\n");
-  }
-  path = path.substr(0, path.find('?'));
-  if (path == "/ws") {
-    const std::string key = headers["sec-websocket-key"];
-    if (lower(headers["upgrade"]) != "websocket" || key.empty()) {
-      ++counters_.bad_requests;
-      return respond(c, 400, "text/plain", "WebSocket upgrade expected\n");
-    }
-    // A subprotocol the client offers and we speak (Sec-WebSocket-Protocol: a comma-separated list).
-    std::istringstream offered(headers["sec-websocket-protocol"]);
-    for (std::string p; std::getline(offered, p, ',');)
-      if (c.subprotocol.empty() && std::count(options_.subprotocols.begin(), options_.subprotocols.end(), trim(p)))
-        c.subprotocol = trim(p);
-    queue(c,
-          "HTTP/1.1 101 Switching Protocols\r\nUpgrade: websocket\r\nConnection: Upgrade\r\nSec-WebSocket-Accept: " +
-              webSocketAccept(key) + "\r\n" +
-              (c.subprotocol.empty() ? "" : "Sec-WebSocket-Protocol: " + c.subprotocol + "\r\n") + "\r\n",
-          -1, false);
+  const HttpAnswer answer = answerRequest(request, options_.subprotocols);
+  if (answer.status == 101) {
+    c.subprotocol = answer.subprotocol;
+    queue(c, answer.handshake, -1, false);
     c.client = next_client_++;
     ++counters_.clients_total;
     return;
   }
-  const std::string name = path == "/" ? "index.html" : path.substr(1);
-  std::ifstream file(options_.web_root + "/" + name, std::ios::binary);
-  if (!plainName(name) || !file) {
+  std::ifstream file;
+  if (answer.status == 200) file.open(options_.web_root + "/" + answer.file, std::ios::binary);
+  if (answer.status == 404 || (answer.status == 200 && !file)) {
     ++counters_.not_found;
     return respond(c, 404, "text/plain", "not found\n");
   }
+  if (answer.status != 200) {
+    ++counters_.bad_requests;
+    return respond(c, answer.status, "text/plain", answer.text);
+  }
   std::ostringstream body;
   body << file.rdbuf();
-  respond(c, 200, contentType(name), body.str());
+  respond(c, 200, contentType(answer.file), body.str());
 }
 
 void WebServer::handleWebSocket(Connection& c) {
+  ClientEvent event;
   for (;;) {
-    const std::string& b = c.in;
-    if (b.size() < 2) return;
-    const auto b0 = static_cast<std::uint8_t>(b[0]), b1 = static_cast<std::uint8_t>(b[1]);
-    const bool fin = b0 & 0x80, masked = b1 & 0x80;
-    const int opcode = b0 & 0x0F;
-    std::uint64_t length = b1 & 0x7F;
-    std::size_t pos = 2;
-    if (length == 126 || length == 127) {
-      const std::size_t bytes = length == 126 ? 2 : 8;
-      if (b.size() < pos + bytes) return;
-      length = 0;
-      for (std::size_t i = 0; i < bytes; ++i) length = (length << 8) | static_cast<std::uint8_t>(b[pos + i]);
-      pos += bytes;
-    }
-    if (!masked || length > options_.max_message_bytes || c.fragments.size() + length > options_.max_message_bytes) {
-      ++counters_.bad_requests;  // RFC 6455: a client's frames are masked; ours are short
+    const Parse parsed = c.frames.next(c.in, event);
+    if (parsed == Parse::kIncomplete) return;
+    if (parsed == Parse::kBad) {
+      ++counters_.bad_requests;
       return close(c.fd);
     }
-    if (b.size() < pos + 4 + length) return;
-    const std::string mask = b.substr(pos, 4);
-    std::string payload = b.substr(pos + 4, static_cast<std::size_t>(length));
-    for (std::size_t i = 0; i < payload.size(); ++i) payload[i] = static_cast<char>(payload[i] ^ mask[i % 4]);
-    c.in.erase(0, pos + 4 + static_cast<std::size_t>(length));
-    if (opcode == 0x8) {  // close: answer and end
+    if (event.kind == ClientEvent::kClose) {  // answer and end
       queue(c, webSocketFrame("", 0x8), -1, false);
       c.close_after_write = true;
+      c.in.clear();
       return;
     }
-    if (opcode == 0x9) {
-      queue(c, webSocketFrame(payload, 0xA), -1, false);
-    } else if (opcode == 0x1 || opcode == 0x2 || opcode == 0x0) {
-      c.fragments += payload;
-      if (fin) {
-        messages_.emplace_back(c.client, std::move(c.fragments));
-        c.fragments.clear();
+    if (event.kind == ClientEvent::kPing) {
+      // Pongs are not dropped like frames: a client that pings without reading is closed instead.
+      if (c.queued_bytes > options_.max_queue_bytes) {
+        ++counters_.bad_requests;
+        return close(c.fd);
       }
+      queue(c, webSocketFrame(event.payload, 0xA), -1, false);
+    } else {
+      messages_.emplace_back(c.client, std::move(event.payload));
     }
   }
 }

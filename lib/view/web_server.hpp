@@ -1,9 +1,12 @@
 // The small HTTP + WebSocket server of adit view (RFC 6455's handshake and framing on POSIX sockets, one
-// thread, poll): GET of the files in one folder (the page and three.js), 404 for any other path, and
-// WebSocket clients on /ws that receive binary frames and may send short text messages. Nothing blocks on a
+// thread, poll; the bytes are parsed by view/web_protocol.hpp): GET of the files in one folder (the page and
+// three.js), 404 for any other path, and WebSocket clients on /ws that receive binary frames and may send
+// short text messages. Nothing blocks on a
 // client: sockets are non-blocking and each client's queue is bounded; when it is full the oldest frame
 // not yet begun is dropped and counted (its tag is reported so that the caller can resend what it held).
 #pragma once
+
+#include "view/web_protocol.hpp"
 
 #include <cstdint>
 #include <deque>
@@ -79,10 +82,5 @@ class WebServer {
   std::vector<int> closed_;
   WebServerCounters counters_;
 };
-
-// Sec-WebSocket-Accept for a Sec-WebSocket-Key (RFC 6455 4.2.2: base64 of SHA-1 of key + the fixed GUID).
-std::string webSocketAccept(const std::string& key);
-// A server-to-client frame (unmasked, FIN) with opcode 2 (binary), 1 (text), 8 (close), 10 (pong).
-std::string webSocketFrame(const std::string& payload, int opcode = 2);
 
 }  // namespace adit::view
