@@ -4,7 +4,8 @@
 #
 #   scripts/fuzz.sh [HARNESS...] [--seconds N] [--build-only | --no-build]
 #
-# HARNESS: pcd kitti lcmlog imu_text config launch_file lidar_packets n100_serial node_messages pcap rosbag (default: all).
+# HARNESS: pcd kitti lcmlog imu_text config launch_file lidar_packets n100_serial node_messages pcap rosbag web_server
+# map_bundle view_messages (default: all).
 # Each runs N seconds (default 60) from its seed corpus (tests/fuzz/corpus/<harness>, copied: the repository's
 # corpus is not changed); inputs it finds interesting stay in build-fuzz/corpus/<harness>, crashes go to
 # build-fuzz/findings/<harness>/. Prints per harness: executions, coverage (cov: edges, ft: features), findings.
@@ -16,14 +17,15 @@ BUILD=$ROOT/build-fuzz
 SECONDS_EACH=60
 BUILD_ONLY=0
 NO_BUILD=0
-ALL=(pcd kitti lcmlog imu_text config launch_file lidar_packets n100_serial node_messages pcap rosbag)
+ALL=(pcd kitti lcmlog imu_text config launch_file lidar_packets n100_serial node_messages pcap rosbag web_server map_bundle
+     view_messages)
 HARNESSES=()
 while [[ $# -gt 0 ]]; do
   case "$1" in
     --seconds) SECONDS_EACH=$2; shift 2 ;;
     --build-only) BUILD_ONLY=1; shift ;;
     --no-build) NO_BUILD=1; shift ;;
-    -h|--help) sed -n '2,12p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,13p' "$0"; exit 0 ;;
     -*) echo "fuzz.sh: unknown option $1" >&2; exit 2 ;;
     *) HARNESSES+=("$1"); shift ;;
   esac
@@ -46,7 +48,8 @@ for h in "${HARNESSES[@]}"; do targets+=("fuzz_$h"); done
 
 export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1:abort_on_error=0}
 export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}
-declare -A MAX_LEN=([pcap]=20000 [rosbag]=20000 [lidar_packets]=20000 [node_messages]=100000 [kitti]=20000 [pcd]=20000 [lcmlog]=20000)
+declare -A MAX_LEN=([pcap]=20000 [rosbag]=20000 [lidar_packets]=20000 [node_messages]=100000 [kitti]=20000 [pcd]=20000 [lcmlog]=20000
+  [map_bundle]=40000 [web_server]=8192 [view_messages]=100000)
 summary=()
 status=0
 for h in "${HARNESSES[@]}"; do

@@ -1,12 +1,18 @@
 // Writes the node_messages seed corpus: a few synthetic 16-beam sweeps of a box-shaped roadway and IMU
 // samples, run through all four pipeline nodes in lockstep; every message a node received is kept, per
-// node, in the harness's input format. Build and run (from the repository root) when the messages change:
-//   cmake --build build --target fuzz_make_node_seeds && build/bin/fuzz_make_node_seeds tests/fuzz/corpus/node_messages
+// node, in the harness's input format. With a second folder, also the view_messages seed: what adit view
+// would have received of the same run (sweeps, mapped poses, graph, map updates) with ground truth, a loop
+// and a STATUS. Build and run (from the repository root) when the messages change:
+//   cmake --build build --target fuzz_make_node_seeds
+//   build/bin/fuzz_make_node_seeds tests/fuzz/corpus/node_messages tests/fuzz/corpus/view_messages
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <map>
 #include <string>
 #include <vector>
+
+#include <adit/status_t.hpp>
 
 #include "msg/convert.hpp"
 #include "msg/encode.hpp"
@@ -55,7 +61,7 @@ adit::LidarScan sweep(int k) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (argc != 2) return 2;
+  if (argc != 2 && argc != 3) return 2;
   const std::string out_dir = argv[1];
   const auto& names = adit::nodes::pipelineNodeNames();
   std::vector<std::unique_ptr<adit::runtime::Node>> nodes;
@@ -77,7 +83,22 @@ int main(int argc, char** argv) {
       }
     }
   };
-  bus.observe([&](const std::string& channel, const adit::runtime::Bytes& data, std::int64_t) { record(channel, data); });
+  // The view harness's input: [channel byte][uint16 size][bytes], channels as fuzz_view_messages.cpp lists them.
+  const std::vector<std::string> view_channels{"LIDAR_POINTS", "ODOM_MAPPED", "GROUND_TRUTH", "POSE_GRAPH",
+                                               "LOOP_CLOSURE", "MAP_UPDATE",  "STATUS_mapper"};
+  std::string view_input;
+  const auto recordView = [&](const std::string& channel, const std::vector<std::uint8_t>& data) {
+    const auto c = std::find(view_channels.begin(), view_channels.end(), channel);
+    if (c == view_channels.end() || data.size() > 65535 || view_input.size() + data.size() > 90000) return;
+    view_input += static_cast<char>(c - view_channels.begin());
+    view_input += static_cast<char>(data.size() & 0xFF);
+    view_input += static_cast<char>(data.size() >> 8);
+    view_input.append(data.begin(), data.end());
+  };
+  bus.observe([&](const std::string& channel, const adit::runtime::Bytes& data, std::int64_t) {
+    record(channel, data);
+    recordView(channel, data);
+  });
   for (int k = 0; k < 6; ++k) {
     for (int j = 0; j < 10; ++j) {
       adit::ImuSample imu;
@@ -93,9 +114,36 @@ int main(int argc, char** argv) {
     const adit::point_cloud_t cloud = adit::msg::toMessage(sweep(k));
     const auto bytes = adit::msg::encode(cloud);
     record("LIDAR_POINTS", bytes);
+    if (k % 3 == 0) recordView("LIDAR_POINTS", bytes);  // two sweeps: the seed stays small
     bus.inject("LIDAR_POINTS", bytes, cloud.header.utime);
+    adit::PoseEstimate truth;
+    truth.utime = cloud.header.utime;
+    truth.pose.translation().x() = 0.05 * k;
+    recordView("GROUND_TRUTH", adit::msg::encode(adit::msg::toMessage(truth, nullptr)));
   }
   bus.finish();
+  adit::LoopConstraint loop;
+  loop.query_index = 5;
+  loop.match_index = 0;
+  loop.query_utime = 1500000;
+  loop.match_utime = 1000000;
+  recordView("LOOP_CLOSURE", adit::msg::encode(adit::msg::toMessage(loop, 1500000)));
+  adit::status_t status{};
+  status.process = "mapper";
+  status.state = "running";
+  status.inputs = 6;
+  status.num_counters = 1;
+  status.counter_names = {"lost_input"};
+  status.counter_values = {2};
+  recordView("STATUS_mapper", adit::msg::encode(status));
+  if (argc == 3) {
+    const std::string path = std::string(argv[2]) + "/run";
+    std::FILE* f = std::fopen(path.c_str(), "wb");
+    if (!f) return 1;
+    std::fwrite(view_input.data(), 1, view_input.size(), f);
+    std::fclose(f);
+    std::printf("%s: %zu bytes\n", path.c_str(), view_input.size());
+  }
   for (std::size_t i = 0; i < nodes.size(); ++i) {
     const std::string path = out_dir + "/" + names[i];
     std::FILE* f = std::fopen(path.c_str(), "wb");

@@ -97,6 +97,24 @@ def ipv4_udp(payload, port, ident, mtu=1500):
                                bytes([192, 168, 1, 201]), bytes([192, 168, 1, 100])) + chunk)
     return out
 
+def ws_frame(payload, opcode=1, fin=True, key=b"\x11\x22\x33\x44"):
+    n = len(payload)
+    head = bytes([(0x80 if fin else 0) | opcode])
+    head += bytes([0x80 | n]) if n < 126 else bytes([0x80 | 126]) + struct.pack(">H", n)
+    return head + key + bytes(b ^ key[i % 4] for i, b in enumerate(payload))
+
+def web_seeds():
+    get = "GET {} HTTP/1.1\r\nHost: robot:8080\r\nUser-Agent: test\r\n\r\n"
+    put("web_server", "get_index", b"\x3f" + get.format("/").encode())
+    put("web_server", "get_files", b"\x07" + (get.format("/app.js?v=2") + get.format("/../etc/passwd")).encode())
+    upgrade = ("GET /ws HTTP/1.1\r\nHost: robot:8080\r\nUpgrade: websocket\r\nConnection: Upgrade\r\n"
+               "Sec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\nSec-WebSocket-Version: 13\r\n{}\r\n")
+    frames = (ws_frame(b"save_map here") + ws_frame(b"frag", fin=False) + ws_frame(b"ment", opcode=0) +
+              ws_frame(b"ping", opcode=9) + ws_frame(bytes(300), opcode=2) + ws_frame(b"", opcode=8))
+    put("web_server", "websocket", b"\xff" + upgrade.format("").encode() + frames)
+    put("web_server", "foxglove", b"\x02" + upgrade.format("Sec-WebSocket-Protocol: x, foxglove.websocket.v1\r\n").encode() +
+        ws_frame(b'{"op":"subscribe","subscriptions":[{"id":1,"channelId":0}]}'))
+
 def pcap_seeds():
     eth = lambda ip: bytes(6) + bytes([0x60, 0x76, 0x88, 0, 0, 2]) + b"\x08\x00" + ip
     # classic, microseconds, little-endian, Ethernet: three VLP-16 packets (model byte 0)
@@ -127,4 +145,4 @@ def pcap_seeds():
     put("pcap", "rs16_sll2_be.pcapng", b"\x01" + ng)
 
 if __name__ == "__main__":
-    pcd_seeds(); kitti_seeds(); lcmlog_seeds(); text_seeds(); pcap_seeds()
+    pcd_seeds(); kitti_seeds(); lcmlog_seeds(); text_seeds(); pcap_seeds(); web_seeds()
