@@ -15,7 +15,7 @@ PACKAGES=(
   openjdk-17-jdk-headless openjdk-17-jre libjchart2d-java
   python3-numpy python3-matplotlib
   libssl-dev libbz2-dev liblz4-dev libzstd-dev
-  iproute2 util-linux nftables curl
+  iproute2 util-linux nftables iptables libnetfilter-queue-dev curl
 )
 # Only the browser and MCAP tests use these (they skip without them). They are checked by command, not by
 # package: Node.js from another vendor (NodeSource's nodejs bundles npm) conflicts with Debian's npm package, and

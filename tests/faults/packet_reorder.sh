@@ -1,0 +1,62 @@
+#!/usr/bin/env bash
+# Reordering on the bus: the simulated live pipeline (launch/sim.launch.yaml) twice in a private network
+# namespace, once in order and once with REORDER_PERCENT (1) of the multicast datagrams arriving after the next
+# 1 to 4 (tests/faults/reorder_queue.cpp behind an iptables NFQUEUE rule: the kernel has no netem). Datagrams,
+# not IP fragments: the INPUT hook sees them reassembled. Checks: no process restarts or stops publishing
+# STATUS, the run ends as planned, sweeps still arrive, and the APE of ODOM_MAPPED against the simulator's
+# ground truth stays within 20 % (+2 cm for run-to-run noise at real time) of the in-order run.
+#   packet_reorder.sh <bin_dir> <source_dir>  env: REORDER_PERCENT (1), MAX_DELAY (4), MTU (1500), DURATION (40), WORLD
+source "$(dirname "$0")/common.sh" "$@"
+PERCENT=${REORDER_PERCENT:-1} DURATION=${DURATION:-40} WORLD=${WORLD:-roadway-straight}
+ip link set lo mtu "${MTU:-1500}"
+sysctl -qw net.ipv4.ipfrag_time=2 net.ipv4.ipfrag_high_thresh=33554432  # as packet_loss.sh and the deployment notes
+if ! command -v iptables > /dev/null; then echo "SKIP: iptables (Debian package iptables) is not installed"; exit 77; fi
+if ! err=$(iptables -A INPUT -d 224.0.0.0/4 -j NFQUEUE --queue-num 7 --queue-bypass 2>&1); then
+  echo "SKIP: no NFQUEUE target here (iptables: $err)"; exit 77
+fi
+iptables -D INPUT -d 224.0.0.0/4 -j NFQUEUE --queue-num 7 --queue-bypass
+
+# run NAME: one simulated live run; facts in $WORK/NAME.facts, APE rmse in $WORK/NAME.ape
+run() {
+  local name=$1 out=$WORK/$1.launch.out
+  start_launch "$out" "$ROOT/launch/sim.launch.yaml" --set WORLD="$WORLD" --set DURATION="$DURATION" \
+    --set 'RECORD=^(ODOM_MAPPED|GROUND_TRUTH|STATUS_.*)$' --log-dir "$WORK/$name" --quiet
+  wait_launch
+  echo "$name: adit launch exit code $LAUNCH_RC; $(tail -1 "$out")"
+  mapfile -t series < <(record_series "$(run_dir "$WORK/$name")")
+  mkdir -p "$WORK/$name.tum"
+  "$BIN/fault-facts" --out "$WORK/$name.tum" "${series[@]}" > "$WORK/$name.facts"
+  if "$BIN/adit" eval --gt "$WORK/$name.tum/truth.tum" --est "$WORK/$name.tum/mapped.tum" --align se3 > "$WORK/$name.eval" 2>&1; then
+    awk '/all poses/ { for (i = 1; i <= NF; ++i) if ($i == "rmse") print $(i + 1) }' "$WORK/$name.eval" > "$WORK/$name.ape"
+  else
+    echo "no trajectory: $(tail -1 "$WORK/$name.eval")"
+    echo none > "$WORK/$name.ape"
+  fi
+  grep -E '^(outputs|drops|restarted|status_gap_s) |lost_input|time_backwards|seq_reset' "$WORK/$name.facts" | tr '\n' ';'; echo
+}
+
+run in_order
+expect "in-order run: exit code" "$LAUNCH_RC" == 0
+"$BIN/reorder-queue" --queue 7 --percent "$PERCENT" --max-delay "${MAX_DELAY:-4}" > "$WORK/reorder.out" 2>&1 &
+REORDER_PID=$!
+trap 'kill -INT "$REORDER_PID" 2>/dev/null || true; cleanup' EXIT
+iptables -A INPUT -d 224.0.0.0/4 -j NFQUEUE --queue-num 7 --queue-bypass
+run reordered
+iptables -D INPUT -d 224.0.0.0/4 -j NFQUEUE --queue-num 7 --queue-bypass
+kill -INT "$REORDER_PID"; wait "$REORDER_PID" || true
+cat "$WORK/reorder.out"
+expect "reordered run: exit code" "$LAUNCH_RC" == 0
+expect "datagrams held back and overtaken" "$(awk '/overtaken/ { print $4 }' "$WORK/reorder.out")" ">" 0
+
+clean_ape=$(cat "$WORK/in_order.ape") reordered_ape=$(cat "$WORK/reordered.ape")
+sweeps=$((DURATION * 10))
+arrived=$(fact "$WORK/reordered.facts" outputs STATUS_FEATURE)
+for p in FEATURE ODOMETRY MAPPER LOOP_CLOSER; do
+  expect "STATUS_$p restarts" "$(fact "$WORK/reordered.facts" restarted STATUS_$p)" == 0
+  expect "longest silence of STATUS_$p (s)" "$(fact "$WORK/reordered.facts" status_gap_s STATUS_$p)" "<" 5
+done
+expect "sweeps that reached the feature stage (of $sweeps)" "$arrived" ">" 0
+expect "APE rmse with $PERCENT % reordered (m; in order $clean_ape m)" "$reordered_ape" "<=" \
+  "$(awk -v a="$clean_ape" 'BEGIN { print (a * 1.2 > a + 0.02) ? a * 1.2 : a + 0.02 }')"
+echo "figure: $PERCENT % of datagrams overtaken by 1-${MAX_DELAY:-4} later ones (MTU ${MTU:-1500}): $arrived of $sweeps sweeps arrived (in order: $(fact "$WORK/in_order.facts" outputs STATUS_FEATURE)), lost_input $(fact "$WORK/reordered.facts" counter STATUS_FEATURE lost_input) (in order: $(fact "$WORK/in_order.facts" counter STATUS_FEATURE lost_input)) and time_backwards $(fact "$WORK/reordered.facts" counter STATUS_FEATURE time_backwards) at the feature stage; APE rmse $reordered_ape m vs $clean_ape m in order"
+exit $failed
