@@ -13,10 +13,13 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <atomic>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <random>
+#include <thread>
 
 namespace {
 
@@ -155,6 +158,8 @@ class Client {
     ::setsockopt(fd_, SOL_SOCKET, SO_RCVBUF, &small, sizeof(small));
   }
   ~Client() { ::close(fd_); }
+  int fd() const { return fd_; }
+  void shutdownBoth() { ::shutdown(fd_, SHUT_RDWR); }
   void send(const std::string& s) { EXPECT_EQ(::send(fd_, s.data(), s.size(), 0), static_cast<ssize_t>(s.size())); }
   std::string receiveSome(WebServer& server) {
     std::string got;
@@ -206,6 +211,39 @@ TEST(WebServer, ServesItsFolderAnd404sTheRest) {
   post.send("POST / HTTP/1.1\r\n\r\n");
   EXPECT_EQ(post.receiveSome(server).rfind("HTTP/1.1 405", 0), 0u);
   EXPECT_EQ(server.counters().not_found, 4);
+}
+
+// A client that sends pings and reads nothing: pongs are not dropped like frames, so its connection is closed
+// once its queue holds more than max_queue_bytes (pongs used to be queued without bound: memory growing as fast
+// as one browser on the LAN could send).
+TEST(WebServer, AClientThatPingsWithoutReadingIsClosed) {
+  WebRoot root;
+  WebServerOptions options = localOptions(root.path.string());
+  options.max_queue_bytes = 1u << 20;
+  WebServer server(options);
+  Client c(server.port());
+  c.send("GET /ws HTTP/1.1\r\nUpgrade: websocket\r\nConnection: Upgrade\r\nSec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\n\r\n");
+  ASSERT_NE(c.receiveSome(server).find("101 Switching Protocols"), std::string::npos);
+  ASSERT_EQ(server.clients().size(), 1u);
+  const int id = server.clients()[0];
+  // Masked (key 0) pings of 60000 bytes, 300 of them (18 MB), sent by a thread while this one serves.
+  const std::string ping = std::string("\x89\xfe\xea\x60\0\0\0\0", 8) + std::string(60000, 'p');
+  std::atomic<bool> sending{true};
+  std::thread sender([&] {
+    for (int i = 0; i < 300; ++i)
+      if (::send(c.fd(), ping.data(), ping.size(), MSG_NOSIGNAL) != static_cast<ssize_t>(ping.size())) break;
+    sending = false;
+  });
+  std::size_t most_queued = 0;
+  for (int i = 0; i < 20000 && (sending || i < 100) && !server.clients().empty(); ++i) {
+    server.poll(1);
+    most_queued = std::max(most_queued, server.queuedBytes(id));
+  }
+  c.shutdownBoth();  // ends a send still blocked
+  sender.join();
+  EXPECT_TRUE(server.clients().empty());
+  EXPECT_LE(most_queued, options.max_queue_bytes + 2 * 65536);
+  EXPECT_GE(server.counters().bad_requests, 1);
 }
 
 TEST(WebServer, ASlowClientLosesItsOldestFramesNotTheServer) {
