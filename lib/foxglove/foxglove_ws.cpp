@@ -1,9 +1,9 @@
 #include "foxglove/foxglove_ws.hpp"
 
 #include "core/json_writer.hpp"
+#include "foxglove/foxglove_client.hpp"
 
 #include <cstring>
-#include <regex>
 
 namespace adit::foxglove {
 
@@ -57,29 +57,9 @@ void FoxgloveWs::publish(const std::string& topic, const SchemaText& schema, con
 bool FoxgloveWs::message(int client, const std::string& text) {
   const auto it = clients_.find(client);
   if (it == clients_.end()) return false;
-  static const std::regex op(R"re("op"\s*:\s*"(\w+)")re");
-  static const std::regex number(R"re("(id|channelId)"\s*:\s*(\d+))re");
-  static const std::regex object(R"re(\{[^{}]*\})re");
-  std::smatch m;
-  if (!std::regex_search(text, m, op)) return true;
-  if (m[1] == "subscribe") {
-    // {"op":"subscribe","subscriptions":[{"id":0,"channelId":3},...]}: each inner object, keys in any order.
-    const auto list = text.find('[');
-    for (std::sregex_iterator o(text.begin() + static_cast<long>(list == std::string::npos ? 0 : list), text.end(), object), end;
-         o != end; ++o) {
-      const std::string one = o->str();
-      long sub = -1, channel = -1;
-      for (std::sregex_iterator n(one.begin(), one.end(), number); n != std::sregex_iterator(); ++n)
-        ((*n)[1] == "id" ? sub : channel) = std::stol((*n)[2]);
-      if (sub >= 0 && channel >= 0) it->second.subscriptions[static_cast<std::uint32_t>(sub)] = static_cast<int>(channel);
-    }
-  } else if (m[1] == "unsubscribe") {
-    const auto list = text.find('[');
-    static const std::regex id(R"(\d+)");
-    for (std::sregex_iterator n(text.begin() + static_cast<long>(list == std::string::npos ? text.size() : list), text.end(), id), end;
-         n != end; ++n)
-      it->second.subscriptions.erase(static_cast<std::uint32_t>(std::stoul(n->str())));
-  }
+  const ClientRequest request = parseClientRequest(text);
+  for (const auto& [subscription, channel] : request.subscribe) it->second.subscriptions[subscription] = channel;
+  for (const std::uint32_t subscription : request.unsubscribe) it->second.subscriptions.erase(subscription);
   return true;
 }
 

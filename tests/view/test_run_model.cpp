@@ -287,3 +287,35 @@ TEST(ViewSession, LateJoinerGetsTheMapOnceThenOnlyWhatChanged) {
 }
 
 }  // namespace
+
+#include "foxglove/foxglove_client.hpp"
+
+namespace adit::foxglove {
+namespace {
+
+TEST(FoxgloveClient, SubscribeAndUnsubscribeAreReadKeysInAnyOrder) {
+  const ClientRequest s = parseClientRequest(
+      R"({"op" : "subscribe", "subscriptions": [{"id": 1, "channelId": 3}, {"channelId":5,"id":2}, {"id": 9}]})");
+  EXPECT_EQ(s.op, ClientRequest::Op::kSubscribe);
+  EXPECT_EQ(s.subscribe, (std::vector<std::pair<std::uint32_t, int>>{{1, 3}, {2, 5}}));
+  const ClientRequest u = parseClientRequest(R"({"op":"unsubscribe","subscriptionIds":[1, 2]})");
+  EXPECT_EQ(u.op, ClientRequest::Op::kUnsubscribe);
+  EXPECT_EQ(u.unsubscribe, (std::vector<std::uint32_t>{1, 2}));
+  EXPECT_EQ(parseClientRequest(R"({"op":"advertise"})").op, ClientRequest::Op::kOther);
+  EXPECT_EQ(parseClientRequest("save_map x").op, ClientRequest::Op::kOther);
+}
+
+// What used to stop adit view --foxglove from the LAN: a 20-digit id (std::stol threw out of the view loop)
+// and a 60 kB object (std::regex recursed once per character and overflowed the stack).
+TEST(FoxgloveClient, HugeNumbersAndLongObjectsAreHarmless) {
+  const ClientRequest big = parseClientRequest(
+      R"({"op":"subscribe","subscriptions":[{"id":99999999999999999999,"channelId":1},{"id":4294967295,"channelId":4294967295}]})");
+  EXPECT_TRUE(big.subscribe.empty());
+  EXPECT_EQ(parseClientRequest(R"({"op":"unsubscribe","subscriptionIds":[123456789012345678901234567890, 7]})").unsubscribe,
+            std::vector<std::uint32_t>{7});
+  const std::string long_object = R"({"op":"subscribe","subscriptions":[{"id":1,)" + std::string(60000, ' ') + R"("channelId":2}]})";
+  EXPECT_EQ(parseClientRequest(long_object).subscribe, (std::vector<std::pair<std::uint32_t, int>>{{1, 2}}));
+}
+
+}  // namespace
+}  // namespace adit::foxglove
