@@ -1,8 +1,10 @@
 // adit view's web server as a browser on the LAN reaches it: an HTTP request head, the answer chosen for it,
 // then (after an upgrade) WebSocket frames, all through lib/view/web_protocol.hpp as the server's connection
-// loop drives it, with the bytes arriving in pieces as recv() would return them.
+// loop drives it, with the bytes arriving in pieces as recv() would return them; each message a client sends
+// is read as a Foxglove client's request (foxglove/foxglove_client.hpp), as adit view --foxglove does.
 // Input: one byte (piece size - 1), then the bytes the client sends.
 #include "fuzz_input.hpp"
+#include "foxglove/foxglove_client.hpp"
 #include "view/web_protocol.hpp"
 
 #include <cstdlib>
@@ -49,6 +51,10 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       require(event.payload.size() <= kMaxMessage);
       if (event.kind == ClientEvent::kClose) return 0;
       if (event.kind == ClientEvent::kPing) require(!webSocketFrame(event.payload, 0xA).empty());
+      if (event.kind == ClientEvent::kMessage) {
+        const adit::foxglove::ClientRequest request = adit::foxglove::parseClientRequest(event.payload);
+        for (const auto& [subscription, channel] : request.subscribe) require(channel >= 0);
+      }
     }
     if (parsed == Parse::kBad) return 0;  // closed
     require(in.size() <= kMaxRequestBytes + kMaxMessage + 14 + piece);

@@ -113,7 +113,8 @@ def web_seeds():
               ws_frame(b"ping", opcode=9) + ws_frame(bytes(300), opcode=2) + ws_frame(b"", opcode=8))
     put("web_server", "websocket", b"\xff" + upgrade.format("").encode() + frames)
     put("web_server", "foxglove", b"\x02" + upgrade.format("Sec-WebSocket-Protocol: x, foxglove.websocket.v1\r\n").encode() +
-        ws_frame(b'{"op":"subscribe","subscriptions":[{"id":1,"channelId":0}]}'))
+        ws_frame(b'{"op":"subscribe","subscriptions":[{"id":1,"channelId":0},{"channelId":2, "id" : 7}]}') +
+        ws_frame(b'{"op":"unsubscribe","subscriptionIds":[1, 7]}'))
 
 def pcap_seeds():
     eth = lambda ip: bytes(6) + bytes([0x60, 0x76, 0x88, 0, 0, 2]) + b"\x08\x00" + ip
