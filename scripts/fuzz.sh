@@ -25,7 +25,7 @@ while [[ $# -gt 0 ]]; do
     --seconds) SECONDS_EACH=$2; shift 2 ;;
     --build-only) BUILD_ONLY=1; shift ;;
     --no-build) NO_BUILD=1; shift ;;
-    -h|--help) sed -n '2,13p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,12p' "$0"; exit 0 ;;
     -*) echo "fuzz.sh: unknown option $1" >&2; exit 2 ;;
     *) HARNESSES+=("$1"); shift ;;
   esac
