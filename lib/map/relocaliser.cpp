@@ -43,6 +43,7 @@ const ConfigTable<RelocaliserConfig>& relocaliserConfigTable() {
      .add("max_verifications", &R::max_verifications, between(1, 100), "", "best candidates verified by ICP per query")
      .add("query_sweeps", &R::query_sweeps, between(1, 100), "sweeps", "newest sweeps merged into the cloud ICP aligns")
      .add("submap_neighbors", &R::submap_neighbors, between(0, 1000), "keyframes", "bundle keyframes each side of a candidate in its submap")
+     .add("submap_radius", &R::submap_radius, atLeast(0), "m", "bundle keyframes within this of a candidate also in its submap")
      .add("query_distance", &R::query_distance, above(0), "m", "driving between two queries while relocalising")
      .add("query_interval_s", &R::query_interval_s, above(0), "s", "or this much sensor time between queries")
      .add("ambiguity_distance", &R::ambiguity_distance, above(0), "m", "fits farther apart than this are different places")
@@ -148,13 +149,20 @@ CompactCloud Relocaliser::queryCloud(const Eigen::Isometry3d& session) const {
   return CompactCloud::encode(voxelDownsample(merged, loop_.keyframe_voxel), static_cast<float>(loop_.keyframe_cloud_step));
 }
 
+// The candidate's neighbours along the mapping drive and, from other passes (a revisit, a parallel roadway's
+// cross-cut), every keyframe within reloc.submap_radius: the search along a roadway then sees the roadway's
+// repeats there, whichever pass mapped them.
 CandidateNeighbourhood Relocaliser::neighbourhood(int m) const {
   CandidateNeighbourhood n;
   const int last = static_cast<int>(bundle_.keyframes.size()) - 1;
-  const Eigen::Isometry3d T_m_map = bundle_.keyframes[static_cast<std::size_t>(m)].pose.inverse();
-  for (int j = std::max(0, m - config_.submap_neighbors); j <= std::min(last, m + config_.submap_neighbors); ++j) {
-    n.clouds.push_back(bundle_.keyframes[static_cast<std::size_t>(j)].cloud);
-    n.T_match_cloud.push_back(T_m_map * bundle_.keyframes[static_cast<std::size_t>(j)].pose);
+  const Eigen::Isometry3d& T_map_m = bundle_.keyframes[static_cast<std::size_t>(m)].pose;
+  const double r2 = config_.submap_radius * config_.submap_radius;
+  for (int j = 0; j <= last; ++j) {
+    const BundleKeyframe& k = bundle_.keyframes[static_cast<std::size_t>(j)];
+    const bool along = std::abs(j - m) <= config_.submap_neighbors;
+    if (!along && (k.pose.translation() - T_map_m.translation()).squaredNorm() > r2) continue;
+    n.clouds.push_back(k.cloud);
+    n.T_match_cloud.push_back(T_map_m.inverse() * k.pose);
   }
   return n;
 }

@@ -37,6 +37,7 @@ struct RelocaliserConfig {
   // 5): a straight roadway constrains a fit along its axis only through what lies tens of metres away (niches,
   // equipment, junctions), which a single sweep sees and a +-5 m submap does not hold.
   int submap_neighbors = 20;
+  double submap_radius = 20.0;   // m: ... and keyframes of other passes this close to the candidate
   double query_distance = 0.5;   // m driven between two queries while relocalising
   double query_interval_s = 1.0; // ... or this much sensor time
   double ambiguity_distance = 3.0;  // m: two fits farther apart than this are different places
