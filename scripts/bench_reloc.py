@@ -154,6 +154,7 @@ def judge_only(a):
 
 
 def main():
+    global OUT
     p = argparse.ArgumentParser()
     p.add_argument("--worlds", nargs="+", default=["roadway-loop", "room-and-pillar"])
     p.add_argument("--drives", type=int, default=50)
@@ -164,8 +165,10 @@ def main():
     p.add_argument("--seed", type=int, default=1)
     p.add_argument("--judge-only", action="store_true", help="judge the drives already in logs/bench-reloc again")
     p.add_argument("--keep-map", action="store_true", help="reuse the mapping drives already in logs/bench-reloc")
+    p.add_argument("--out", default=None, help="folder of the runs (default logs/bench-reloc)")
     p.add_argument("--config", nargs="+", default=[], help="configuration files for the short drives' replays")
     a = p.parse_args()
+    OUT = os.path.abspath(a.out) if a.out else OUT
     if a.judge_only:
         return judge_only(a)
     for world in a.worlds:
