@@ -18,7 +18,9 @@ namespace {
 Eigen::Vector3d weakTranslation(const IcpResult& fit, const LoopVerifierConfig& verifier, const AxialSearchConfig& config) {
   const Matrix6d& H = fit.hessian;
   const Eigen::Matrix3d Htt = H.topLeftCorner<3, 3>(), Hrr = H.bottomRightCorner<3, 3>(), Htr = H.topRightCorner<3, 3>();
-  const Eigen::FullPivLU<Eigen::Matrix3d> rr(Hrr), tt(Htt);
+  // The weak translation may be wholly unconstrained (nothing but repeats in view): a tiny ridge keeps the
+  // rotation's marginal finite there.
+  const Eigen::FullPivLU<Eigen::Matrix3d> rr(Hrr), tt(Htt + 1e-6 * Htt.trace() * Eigen::Matrix3d::Identity());
   if (!rr.isInvertible() || !tt.isInvertible()) return Eigen::Vector3d::Zero();
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> trans(Htt - Htr * rr.solve(Htr.transpose()));
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> rot(Hrr - Htr.transpose() * tt.solve(Htr));
