@@ -192,7 +192,12 @@ LoopVerification Relocaliser::verify(const PlaneTarget& target, const std::vecto
   search = searchWeakDirection(target, source, v.icp, loop_.verifier, config_.axial);
   if (std::string(search.refusal) == "ambiguous") ++stats_.axial_ambiguous;
   if (!search.resolved) {
+    // Refused, but its line's best place is what another candidate's fit must beat (the ambiguity test).
     v.verdict = LoopVerdict::kDegenerate;
+    if (search.icp.inlier_ratio > v.icp.inlier_ratio) {
+      v.icp = search.icp;
+      v.T_match_query = search.T_target_source;
+    }
     return v;
   }
   ++stats_.axial_resolved;
