@@ -13,6 +13,7 @@ own drift. Time to first fix: sensor time from the first sweep, and the relocali
 Inside = the drive starts within 3 m of the mapped path; outside = every pose of the drive is > 40 m from it.
 
   scripts/bench_reloc.py [--worlds W ...] [--drives 50] [--outside 10] [--duration 20] [--map-duration 200] [--jobs 2]
+                         [--keep-map] [--judge-only]
 Needs a build (build/bin/adit) and numpy (Debian python3-numpy: run with /usr/bin/python3). Keeps its runs in
 logs/bench-reloc/ and prints a Markdown table.
 """
@@ -74,7 +75,7 @@ def map_world(world, duration, seed, build=True):
     return {"dir": d, "positions": positions, "anchors": anchors, "route_m": route}
 
 
-def short_drive(world, m, seed, index, start, reverse, duration):
+def short_drive(world, m, seed, index, start, reverse, duration, configs=()):
     d = os.path.join(m["dir"], f"drive{index:03d}")
     os.makedirs(d, exist_ok=True)
     log, gt = os.path.join(d, "in.lcmlog"), os.path.join(d, "gt.tum")
@@ -82,7 +83,7 @@ def short_drive(world, m, seed, index, start, reverse, duration):
             "-o", log, "--gt", gt]
     run(args + (["--reverse"] if reverse else []))
     run(["replay", log, "-o", os.path.join(d, "run"), "--prior-map", os.path.join(m["dir"], "bundle"), "--no-progress",
-         "--record", "^$"])
+         "--record", "^$"] + (["--config"] + list(configs) if configs else []))
     os.remove(log)
     return judge(m, d, index, start, reverse)
 
@@ -153,6 +154,7 @@ def judge_only(a):
 
 
 def main():
+    global OUT
     p = argparse.ArgumentParser()
     p.add_argument("--worlds", nargs="+", default=["roadway-loop", "room-and-pillar"])
     p.add_argument("--drives", type=int, default=50)
@@ -162,21 +164,31 @@ def main():
     p.add_argument("--jobs", type=int, default=2)
     p.add_argument("--seed", type=int, default=1)
     p.add_argument("--judge-only", action="store_true", help="judge the drives already in logs/bench-reloc again")
+    p.add_argument("--keep-map", action="store_true", help="reuse the mapping drives already in logs/bench-reloc")
+    p.add_argument("--out", default=None, help="folder of the runs (default logs/bench-reloc)")
+    p.add_argument("--config", nargs="+", default=[], help="configuration files for the short drives' replays")
     a = p.parse_args()
+    OUT = os.path.abspath(a.out) if a.out else OUT
     if a.judge_only:
         return judge_only(a)
     for world in a.worlds:
-        shutil.rmtree(os.path.join(OUT, world), ignore_errors=True)
+        if a.keep_map:
+            for name in os.listdir(os.path.join(OUT, world)):
+                if name.startswith("drive"):
+                    shutil.rmtree(os.path.join(OUT, world, name))
+        else:
+            shutil.rmtree(os.path.join(OUT, world), ignore_errors=True)
     lines = ["| world | starts | drives | success (0.3 m / 2 deg) | of them fixed within 2 s | wrong | no fix | "
              "time to first fix, sensor s (median / max) | compute ms (median) |", "|---|---|---|---|---|---|---|---|---|"]
     for world in a.worlds:
-        m = map_world(world, a.map_duration, a.seed)
+        m = map_world(world, a.map_duration, a.seed, build=not a.keep_map)
         mapped = float(np.sum(np.linalg.norm(np.diff(m["positions"], axis=0), axis=1)))
         rng = random.Random(a.seed)
         outside = a.outside if m["route_m"] > mapped + 180.0 and world == "roadway-loop" else 0
         plan = starts(rng, m, a.drives, outside, mapped)
         with ThreadPoolExecutor(a.jobs) as pool:
-            results = list(pool.map(lambda ia: short_drive(world, m, a.seed, ia[0], ia[1][0], ia[1][1], a.duration),
+            results = list(pool.map(lambda ia: short_drive(world, m, a.seed, ia[0], ia[1][0], ia[1][1], a.duration,
+                                                                [os.path.abspath(c) for c in a.config]),
                                     enumerate(plan)))
         json.dump(results, open(os.path.join(m["dir"], "results.json"), "w"), indent=1)
         print(f"{world}: mapped {mapped:.0f} m of a {m['route_m']} m route; {len(results)} drives", file=sys.stderr)

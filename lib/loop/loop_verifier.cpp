@@ -14,36 +14,40 @@ std::vector<Eigen::Vector3f> buildSubmap(const std::vector<SubmapPiece>& pieces,
   return voxelDownsample(merged, voxel);
 }
 
-namespace {
-
 // A tight fit, converged or not: an alignment still sliding along an unconstrained direction fits tightly too,
 // and is reported as degenerate rather than as a poor fit.
-bool fits(const IcpResult& r, const LoopVerifierConfig& config) {
+bool fitsTightly(const IcpResult& r, const LoopVerifierConfig& config) {
   return r.rms <= config.max_rms && r.inlier_ratio >= config.min_inlier_ratio;
 }
 
-}  // namespace
+std::vector<Eigen::Vector3f> querySource(const std::vector<Eigen::Vector3f>& query_cloud, const LoopVerifierConfig& config) {
+  return voxelDownsample(query_cloud, config.query_voxel);
+}
 
 LoopVerification verifyLoop(const std::vector<Eigen::Vector3f>& query_cloud,
                             const std::vector<Eigen::Vector3f>& submap,
                             const std::vector<Eigen::Isometry3d>& seeds, const LoopVerifierConfig& config) {
-  LoopVerification out;
-  const std::vector<Eigen::Vector3f> source = voxelDownsample(query_cloud, config.query_voxel);
   const PlaneTarget target(submap, config.icp);
+  return verifyLoopAgainst(target, querySource(query_cloud, config), seeds, config);
+}
+
+LoopVerification verifyLoopAgainst(const PlaneTarget& target, const std::vector<Eigen::Vector3f>& source,
+                                   const std::vector<Eigen::Isometry3d>& seeds, const LoopVerifierConfig& config) {
+  LoopVerification out;
   if (source.size() < 30 || target.planarPoints() < 30 || seeds.empty()) return out;
 
   out.verdict = LoopVerdict::kPoorFitness;
   for (std::size_t i = 0; i < seeds.size(); ++i) {
     const IcpResult r = alignPointToPlane(target, source, seeds[i], config.icp);
     const bool better = out.seed < 0 || r.inlier_ratio > out.icp.inlier_ratio;
-    if (fits(r, config) || better) {
+    if (fitsTightly(r, config) || better) {
       out.icp = r;
       out.seed = static_cast<int>(i);
       out.T_match_query = r.T_target_source;
     }
-    if (fits(r, config)) break;
+    if (fitsTightly(r, config)) break;
   }
-  if (!fits(out.icp, config)) return out;
+  if (!fitsTightly(out.icp, config)) return out;
   if (out.icp.eigenvalue_ratio < config.min_eigenvalue_ratio)
     out.verdict = LoopVerdict::kDegenerate;
   else if (out.icp.converged)

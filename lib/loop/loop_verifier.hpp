@@ -53,6 +53,15 @@ LoopVerification verifyLoop(const std::vector<Eigen::Vector3f>& query_cloud,
                             const std::vector<Eigen::Vector3f>& submap,
                             const std::vector<Eigen::Isometry3d>& seeds, const LoopVerifierConfig& config);
 
+// The same against a target built once (PlaneTarget(submap, config.icp)) and a source already downsampled
+// (querySource), for a caller that aligns one query against one target from further seeds afterwards.
+LoopVerification verifyLoopAgainst(const PlaneTarget& target, const std::vector<Eigen::Vector3f>& source,
+                                   const std::vector<Eigen::Isometry3d>& seeds, const LoopVerifierConfig& config);
+std::vector<Eigen::Vector3f> querySource(const std::vector<Eigen::Vector3f>& query_cloud, const LoopVerifierConfig& config);
+
+// A tight fit (inlier RMS and ratio), converged or not.
+bool fitsTightly(const IcpResult& result, const LoopVerifierConfig& config);
+
 const char* toString(LoopVerdict verdict);
 
 }  // namespace adit

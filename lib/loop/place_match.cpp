@@ -32,16 +32,19 @@ Eigen::Isometry3d scanContextSeed(const Eigen::Isometry3d& T_world_query, const 
   return T;
 }
 
-LoopVerification verifyCandidate(const CompactCloud& query, const CandidateNeighbourhood& neighbourhood,
-                                 const std::vector<Eigen::Isometry3d>& seeds, const LoopVerifierConfig& config) {
+std::unique_ptr<PlaneTarget> candidateTarget(const CandidateNeighbourhood& neighbourhood, const LoopVerifierConfig& config) {
   std::vector<std::vector<Eigen::Vector3f>> clouds;
   clouds.reserve(neighbourhood.clouds.size());
   for (const CompactCloud& cloud : neighbourhood.clouds) clouds.push_back(cloud.decode());
   std::vector<SubmapPiece> pieces;
   for (std::size_t i = 0; i < clouds.size() && i < neighbourhood.T_match_cloud.size(); ++i)
     pieces.push_back({&clouds[i], neighbourhood.T_match_cloud[i]});
-  const std::vector<Eigen::Vector3f> submap = buildSubmap(pieces, config.submap_voxel);
-  return verifyLoop(query.decode(), submap, seeds, config);
+  return std::make_unique<PlaneTarget>(buildSubmap(pieces, config.submap_voxel), config.icp);
+}
+
+LoopVerification verifyCandidate(const CompactCloud& query, const CandidateNeighbourhood& neighbourhood,
+                                 const std::vector<Eigen::Isometry3d>& seeds, const LoopVerifierConfig& config) {
+  return verifyLoopAgainst(*candidateTarget(neighbourhood, config), querySource(query.decode(), config), seeds, config);
 }
 
 }  // namespace adit

@@ -10,6 +10,7 @@
 
 #include <Eigen/Geometry>
 
+#include <memory>
 #include <vector>
 
 namespace adit {
@@ -32,6 +33,9 @@ struct CandidateNeighbourhood {
   std::vector<CompactCloud> clouds;
   std::vector<Eigen::Isometry3d> T_match_cloud;
 };
+
+// The neighbourhood's submap (in the candidate's frame) as an ICP target.
+std::unique_ptr<PlaneTarget> candidateTarget(const CandidateNeighbourhood& neighbourhood, const LoopVerifierConfig& config);
 
 // ICP of the query keyframe's cloud against the neighbourhood's submap, from the seeds in order (verifyLoop).
 LoopVerification verifyCandidate(const CompactCloud& query, const CandidateNeighbourhood& neighbourhood,

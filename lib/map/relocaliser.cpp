@@ -8,6 +8,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
+#include <string>
 
 namespace adit {
 namespace {
@@ -41,6 +43,7 @@ const ConfigTable<RelocaliserConfig>& relocaliserConfigTable() {
      .add("max_verifications", &R::max_verifications, between(1, 100), "", "best candidates verified by ICP per query")
      .add("query_sweeps", &R::query_sweeps, between(1, 100), "sweeps", "newest sweeps merged into the cloud ICP aligns")
      .add("submap_neighbors", &R::submap_neighbors, between(0, 1000), "keyframes", "bundle keyframes each side of a candidate in its submap")
+     .add("submap_radius", &R::submap_radius, atLeast(0), "m", "bundle keyframes within this of a candidate also in its submap")
      .add("query_distance", &R::query_distance, above(0), "m", "driving between two queries while relocalising")
      .add("query_interval_s", &R::query_interval_s, above(0), "s", "or this much sensor time between queries")
      .add("ambiguity_distance", &R::ambiguity_distance, above(0), "m", "fits farther apart than this are different places")
@@ -50,7 +53,8 @@ const ConfigTable<RelocaliserConfig>& relocaliserConfigTable() {
      .add("track_distance", &R::track_distance, above(0), "m", "driving between tracking verifications once localised")
      .add("max_track_correction", &R::max_track_correction, above(0), "m", "a tracking fit moving the pose more than this is refused")
      .add("max_track_failures", &R::max_track_failures, between(1, 100000), "", "failed tracking verifications in a row that make the run lost")
-     .add("max_stall_s", &R::max_stall_s, above(0), "s", "a gap in the input longer than this makes the run lost");
+     .add("max_stall_s", &R::max_stall_s, above(0), "s", "a gap in the input longer than this makes the run lost")
+     .nest(&R::axial, axialSearchConfigTable());
     return t;
   }();
   return table;
@@ -145,39 +149,101 @@ CompactCloud Relocaliser::queryCloud(const Eigen::Isometry3d& session) const {
   return CompactCloud::encode(voxelDownsample(merged, loop_.keyframe_voxel), static_cast<float>(loop_.keyframe_cloud_step));
 }
 
+// The candidate's neighbours along the mapping drive and, from other passes (a revisit, a parallel roadway's
+// cross-cut), every keyframe within reloc.submap_radius: the search along a roadway then sees the roadway's
+// repeats there, whichever pass mapped them.
 CandidateNeighbourhood Relocaliser::neighbourhood(int m) const {
   CandidateNeighbourhood n;
   const int last = static_cast<int>(bundle_.keyframes.size()) - 1;
-  const Eigen::Isometry3d T_m_map = bundle_.keyframes[static_cast<std::size_t>(m)].pose.inverse();
-  for (int j = std::max(0, m - config_.submap_neighbors); j <= std::min(last, m + config_.submap_neighbors); ++j) {
-    n.clouds.push_back(bundle_.keyframes[static_cast<std::size_t>(j)].cloud);
-    n.T_match_cloud.push_back(T_m_map * bundle_.keyframes[static_cast<std::size_t>(j)].pose);
+  const Eigen::Isometry3d& T_map_m = bundle_.keyframes[static_cast<std::size_t>(m)].pose;
+  const double r2 = config_.submap_radius * config_.submap_radius;
+  for (int j = 0; j <= last; ++j) {
+    const BundleKeyframe& k = bundle_.keyframes[static_cast<std::size_t>(j)];
+    const bool along = std::abs(j - m) <= config_.submap_neighbors;
+    if (!along && (k.pose.translation() - T_map_m.translation()).squaredNorm() > r2) continue;
+    n.clouds.push_back(k.cloud);
+    n.T_match_cloud.push_back(T_map_m.inverse() * k.pose);
   }
   return n;
 }
 
-// One query: Scan Context candidates, ICP verification, ambiguity test. The verified, unambiguous fit or none.
+// One query: Scan Context candidates, ICP verification (a fit weak along the roadway searched along it),
+// ambiguity test. The verified, unambiguous fit or none.
 std::optional<Relocaliser::Fix> Relocaliser::query(const PoseEstimate& session, const std::vector<Eigen::Vector3f>& cloud) {
   ++stats_.queries;
+  RelocQueryRecord record;
+  record.utime = session.utime;
+  const std::optional<Fix> fix = bestFix(session, cloud, record);
+  if (query_log_.size() < kMaxQueryLog) query_log_.push_back(record);
+  return fix;
+}
+
+// A candidate's verification. A tight fit is then searched along its least constrained translation (the
+// roadway's axis on a straight) against the same target, and kept only if that pins it: the loop closer's
+// degeneracy test refuses nearly every single-sweep fit on a straight, and a fit it accepts can still be one of
+// several along a repeating roadway.
+LoopVerification Relocaliser::verify(const PlaneTarget& target, const std::vector<Eigen::Vector3f>& source,
+                                     const Eigen::Isometry3d& seed, AxialSearchResult& search) {
+  ++stats_.verified;
+  LoopVerification v = verifyLoopAgainst(target, source, {seed}, loop_.verifier);
+  const bool tight = v.verdict == LoopVerdict::kDegenerate || v.verdict == LoopVerdict::kAccepted;
+  if (!tight || !config_.axial.enabled) return v;
+  ++stats_.axial_searches;
+  search = searchWeakDirection(target, source, v.icp, loop_.verifier, config_.axial);
+  if (std::string(search.refusal) == "ambiguous") ++stats_.axial_ambiguous;
+  if (!search.resolved) {
+    // Refused, but its line's best place is what another candidate's fit must beat (the ambiguity test).
+    v.verdict = LoopVerdict::kDegenerate;
+    if (search.icp.inlier_ratio > v.icp.inlier_ratio) {
+      v.icp = search.icp;
+      v.T_match_query = search.T_target_source;
+    }
+    return v;
+  }
+  ++stats_.axial_resolved;
+  v.verdict = LoopVerdict::kAccepted;
+  v.icp = search.icp;
+  v.T_match_query = search.T_target_source;
+  return v;
+}
+
+std::optional<Relocaliser::Fix> Relocaliser::bestFix(const PoseEstimate& session, const std::vector<Eigen::Vector3f>& cloud,
+                                                     RelocQueryRecord& record) {
+  record.outcome = "no_candidate";
   const ScanContext context = keyframeScanContext(cloud, session.pose, loop_.level_scan_context, loop_.scan_context);
   if (context.empty() || database_.size() == 0) return std::nullopt;
-  const CompactCloud compact = queryCloud(session.pose);
+  const std::vector<Eigen::Vector3f> source = querySource(queryCloud(session.pose).decode(), loop_.verifier);
   struct Tried {
     Fix fix;
     LoopVerification v;
+    AxialSearchResult search;
+  };
+  const auto mapPose = [this](const Fix& f) { return bundle_.keyframes[static_cast<std::size_t>(f.match)].pose * f.T_match_query; };
+  // A candidate on a line already searched (the same straight, Scan Context ranks its keyframes alike) adds
+  // nothing but compute.
+  const auto searched = [&](const std::vector<Tried>& done, const Eigen::Vector3d& at) {
+    return std::any_of(done.begin(), done.end(), [&](const Tried& t) {
+      if (t.search.axis.isZero()) return false;
+      const Eigen::Isometry3d& match = bundle_.keyframes[static_cast<std::size_t>(t.fix.match)].pose;
+      const Eigen::Vector3d axis = match.linear() * t.search.axis, d = at - mapPose(t.fix).translation();
+      const double along = d.dot(axis);
+      return std::abs(along) < config_.axial.range - config_.ambiguity_distance &&
+             (d - along * axis).norm() < config_.ambiguity_distance;
+    });
   };
   std::vector<Tried> tried;
+  int candidates = 0;
   for (const ScanContextCandidate& c : database_.query(context, 0)) {
-    if (c.distance > loop_.max_scan_context_distance || static_cast<int>(tried.size()) >= config_.max_verifications) break;
+    if (c.distance > loop_.max_scan_context_distance || candidates >= config_.max_verifications) break;
+    ++candidates;
     const BundleKeyframe& match = bundle_.keyframes[static_cast<std::size_t>(c.index)];
-    const std::vector<Eigen::Isometry3d> seeds{scanContextSeed(session.pose, match.pose, c.yaw, loop_.level_scan_context)};
-    ++stats_.verified;
+    if (searched(tried, match.pose.translation())) continue;
+    const std::unique_ptr<PlaneTarget> target = candidateTarget(neighbourhood(c.index), loop_.verifier);
     Tried t;
-    t.v = verifyCandidate(compact, neighbourhood(c.index), seeds, loop_.verifier);
+    t.v = verify(*target, source, scanContextSeed(session.pose, match.pose, c.yaw, loop_.level_scan_context), t.search);
     t.fix = {c.index, t.v.T_match_query, session.pose, travelled_};
     tried.push_back(t);
   }
-  const auto mapPose = [this](const Fix& f) { return bundle_.keyframes[static_cast<std::size_t>(f.match)].pose * f.T_match_query; };
   const Tried* best = nullptr;
   for (const Tried& t : tried)
     if (t.v.verdict == LoopVerdict::kAccepted && (!best || t.v.icp.inlier_ratio > best->v.icp.inlier_ratio)) best = &t;
@@ -186,17 +252,30 @@ std::optional<Relocaliser::Fix> Relocaliser::query(const PoseEstimate& session, 
                                         [](const Tried& t) { return t.v.verdict == LoopVerdict::kDegenerate; });
     if (degenerate) ++stats_.rejected_degenerate;
     else if (!tried.empty()) ++stats_.rejected_fit;
+    record.outcome = degenerate ? "degenerate" : "fit";
+    for (const Tried& t : tried)
+      if (t.v.verdict == LoopVerdict::kDegenerate && t.v.icp.inlier_ratio > record.inlier_ratio) {
+        record.T_map_lidar = mapPose(t.fix);
+        record.inlier_ratio = t.v.icp.inlier_ratio;
+        record.runner_up = t.search.runner_up;
+      }
     return std::nullopt;
   }
+  record.T_map_lidar = mapPose(best->fix);
+  record.inlier_ratio = best->v.icp.inlier_ratio;
+  record.runner_up = best->search.runner_up;
   const Eigen::Vector3d at = mapPose(best->fix).translation();
   for (const Tried& t : tried) {
     if (&t == best || t.v.seed < 0) continue;
     const bool elsewhere = (mapPose(t.fix).translation() - at).norm() > config_.ambiguity_distance;
     if (elsewhere && t.v.icp.inlier_ratio >= best->v.icp.inlier_ratio - config_.ambiguity_margin) {
       ++stats_.rejected_ambiguous;
+      record.outcome = "ambiguous";
+      record.runner_up = std::max(record.runner_up, t.v.icp.inlier_ratio);
       return std::nullopt;
     }
   }
+  record.outcome = "candidate";
   return best->fix;
 }
 

@@ -18,6 +18,7 @@
 #include "core/types.hpp"
 #include "loop/loop_closer.hpp"
 #include "loop/place_match.hpp"
+#include "map/axial_search.hpp"
 #include "map/map_bundle.hpp"
 
 #include <deque>
@@ -36,6 +37,7 @@ struct RelocaliserConfig {
   // 5): a straight roadway constrains a fit along its axis only through what lies tens of metres away (niches,
   // equipment, junctions), which a single sweep sees and a +-5 m submap does not hold.
   int submap_neighbors = 20;
+  double submap_radius = 20.0;   // m: ... and keyframes of other passes this close to the candidate
   double query_distance = 0.5;   // m driven between two queries while relocalising
   double query_interval_s = 1.0; // ... or this much sensor time
   double ambiguity_distance = 3.0;  // m: two fits farther apart than this are different places
@@ -46,6 +48,8 @@ struct RelocaliserConfig {
   double max_track_correction = 1.0;  // m: a tracking fit moving the pose more than this is refused
   int max_track_failures = 8;       // failed tracking verifications in a row: lost
   double max_stall_s = 1.0;         // a gap in the input longer than this: lost
+  // A query's fit that is tight but weak along the roadway is searched along it (map/axial_search.hpp).
+  AxialSearchConfig axial;
 };
 
 const ConfigTable<RelocaliserConfig>& relocaliserConfigTable();
@@ -58,12 +62,24 @@ struct RelocStats {
   int verified = 0;             // candidates verified by ICP
   int rejected_fit = 0;         // no candidate fitted tightly
   int rejected_degenerate = 0;  // the best fit left a direction unconstrained (a featureless stretch)
+  int axial_searches = 0;       // degenerate fits searched along their weak direction
+  int axial_resolved = 0;       // ... that the search pinned
+  int axial_ambiguous = 0;      // ... where a fit elsewhere along the line came within the margin
   int rejected_ambiguous = 0;   // a fit elsewhere nearly as good
   int rejected_inconsistent = 0;// disagreed with the pending fixes
   int fixes = 0;                // times localised (first fix and each relocalisation after being lost)
   int lost = 0;
   int track_verified = 0, track_failed = 0;
   int track_degenerate = 0;     // fits but constrains too few directions: kept, not a failure
+};
+
+// One relocalising query, for the benchmark's diagnosis (relocaliser's products): what it found and why it was
+// or was not taken. Kept only while relocalising, at most kMaxQueryLog.
+struct RelocQueryRecord {
+  std::int64_t utime = 0;
+  const char* outcome = "";        // candidate, no_candidate, fit, degenerate, ambiguous
+  Eigen::Isometry3d T_map_lidar = Eigen::Isometry3d::Identity();  // the best fit, when there was one
+  double inlier_ratio = 0.0, runner_up = 0.0;
 };
 
 class Relocaliser {
@@ -81,6 +97,8 @@ class Relocaliser {
 
   RelocState state() const { return state_; }
   const RelocStats& stats() const { return stats_; }
+  const std::vector<RelocQueryRecord>& queryLog() const { return query_log_; }
+  static constexpr std::size_t kMaxQueryLog = 2000;
   const MapBundle& bundle() const { return bundle_; }
 
  private:
@@ -93,6 +111,9 @@ class Relocaliser {
   void relocalise(const PoseEstimate& session, Result& result);
   void track(const PoseEstimate& session);
   std::optional<Fix> query(const PoseEstimate& session, const std::vector<Eigen::Vector3f>& cloud);
+  std::optional<Fix> bestFix(const PoseEstimate& session, const std::vector<Eigen::Vector3f>& cloud, RelocQueryRecord& record);
+  LoopVerification verify(const PlaneTarget& target, const std::vector<Eigen::Vector3f>& source,
+                          const Eigen::Isometry3d& seed, AxialSearchResult& search);
   bool consistent(const Fix& a, const Fix& b) const;
   CandidateNeighbourhood neighbourhood(int match) const;
   CompactCloud queryCloud(const Eigen::Isometry3d& session) const;
@@ -106,6 +127,7 @@ class Relocaliser {
   Eigen::Isometry3d T_map_session_ = Eigen::Isometry3d::Identity();
   std::vector<Fix> pending_;
   RelocStats stats_;
+  std::vector<RelocQueryRecord> query_log_;
   // Session motion bookkeeping.
   bool have_last_ = false;
   Eigen::Isometry3d last_pose_ = Eigen::Isometry3d::Identity();

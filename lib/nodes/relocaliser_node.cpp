@@ -45,9 +45,11 @@ class RelocaliserNode : public runtime::Node, public WritesProducts {
     namespace fs = std::filesystem;
     const std::string trajectory = (fs::path(out_dir) / "map_trajectory.tum").string();
     const std::string summary = (fs::path(out_dir) / "relocalisation.json").string();
+    const std::string queries = (fs::path(out_dir) / "reloc_queries.txt").string();
     eval::writeTum(trajectory, in_map_);
     io::writeFileAtomically(summary, summaryJson());
-    return {trajectory, summary};
+    io::writeFileAtomically(queries, queryLogText());
+    return {trajectory, summary, queries};
   }
 
  private:
@@ -86,6 +88,20 @@ class RelocaliserNode : public runtime::Node, public WritesProducts {
     setCount("track_failed", s.track_failed);
   }
 
+  // Every relocalising query: its outcome and best fit in the map frame (TUM pose), for diagnosis.
+  std::string queryLogText() const {
+    std::string out = "# sensor_s outcome x y z qx qy qz qw inlier_ratio runner_up\n";
+    if (!relocaliser_) return out;
+    for (const RelocQueryRecord& r : relocaliser_->queryLog()) {
+      const Eigen::Vector3d t = r.T_map_lidar.translation();
+      const Eigen::Quaterniond q(r.T_map_lidar.linear());
+      out += fmt::format("{:.6f} {} {:.4f} {:.4f} {:.4f} {:.6f} {:.6f} {:.6f} {:.6f} {:.3f} {:.3f}\n",
+                         static_cast<double>(r.utime) * 1e-6, r.outcome, t.x(), t.y(), t.z(), q.x(), q.y(), q.z(), q.w(),
+                         r.inlier_ratio, r.runner_up);
+    }
+    return out;
+  }
+
   std::string summaryJson() const {
     const RelocStats s = relocaliser_ ? relocaliser_->stats() : RelocStats{};
     const double fix_s = first_fix_ ? static_cast<double>(*first_fix_ - first_utime_) * 1e-6 : -1.0;
@@ -93,9 +109,10 @@ class RelocaliserNode : public runtime::Node, public WritesProducts {
         "{{\n  \"state\": \"{}\",\n  \"first_fix_sensor_s\": {:.3f},\n  \"first_fix_utime\": {},\n"
         "  \"first_fix_compute_ms\": {:.1f},\n  \"poses_in_map\": {},\n  \"queries\": {},\n  \"fixes\": {},\n"
         "  \"lost\": {},\n  \"rejected_fit\": {},\n  \"rejected_degenerate\": {},\n  \"rejected_ambiguous\": {},\n  \"rejected_inconsistent\": {},\n"
+        "  \"axial_searches\": {},\n  \"axial_resolved\": {},\n  \"axial_ambiguous\": {},\n"
         "  \"track_verified\": {},\n  \"track_failed\": {},\n  \"track_degenerate\": {}\n}}\n",
         state(), fix_s, first_fix_.value_or(0), compute_ms_, in_map_.size(), s.queries, s.fixes, s.lost, s.rejected_fit, s.rejected_degenerate,
-        s.rejected_ambiguous, s.rejected_inconsistent, s.track_verified, s.track_failed, s.track_degenerate);
+        s.rejected_ambiguous, s.rejected_inconsistent, s.axial_searches, s.axial_resolved, s.axial_ambiguous, s.track_verified, s.track_failed, s.track_degenerate);
   }
 
   std::optional<Relocaliser> relocaliser_;

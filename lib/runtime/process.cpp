@@ -95,6 +95,7 @@ void addProcessOptions(CLI::App& app, ProcessOptions& o) {
   app.add_option("--config", o.config_paths,
                  "YAML configuration, repeatable: later files override earlier ones (default: built-in defaults, "
                  "which launch/config/pipeline.yaml lists)");
+  app.add_option("--set", o.config_sets, "Configuration key over the --config files: KEY=VALUE (repeatable), e.g. reloc.prior_map=DIR");
   app.add_option("--channel", o.channel_remaps, "Rename a channel: PORT=CHANNEL (repeatable)");
   app.add_option("--status-period", o.status_period_s, "Seconds between STATUS messages")->check(CLI::PositiveNumber);
   app.add_option("--run-dir", o.run_dir,
@@ -122,6 +123,14 @@ Config loadConfig(const std::vector<std::string>& paths) {
   return config;
 }
 
+void applyConfigSets(Config& config, const std::vector<std::string>& sets) {
+  for (const auto& s : sets) {
+    const auto eq = s.find('=');
+    if (eq == std::string::npos || eq == 0) throw std::runtime_error("--set expects KEY=VALUE, got '" + s + "'");
+    config.set(s.substr(0, eq), s.substr(eq + 1));
+  }
+}
+
 void applyRemaps(Node& node, const std::vector<std::string>& remaps) {
   for (const auto& r : remaps) {
     const auto eq = r.find('=');
@@ -142,7 +151,9 @@ int runNodeProcess(int argc, char** argv, const std::string& name, const std::st
 
   std::unique_ptr<Node> node;
   try {
-    node = factory(loadConfig(options.config_paths));
+    Config config = loadConfig(options.config_paths);
+    applyConfigSets(config, options.config_sets);
+    node = factory(config);
     applyRemaps(*node, options.channel_remaps);
     node->useRunFolder(liveRunFolder(options.run_dir));
     // An unreadable key stops the process: the operator asked for signed commands, so obeying anyone is wrong.

@@ -20,6 +20,7 @@ struct ProcessOptions {
   std::string lcm_url;  // subscribe (and publish) here; "" = $LCM_DEFAULT_URL or LCM's default
   std::string out_url;  // publish here instead, if set
   std::vector<std::string> config_paths;  // merged in order: later files override earlier ones
+  std::vector<std::string> config_sets;   // KEY=VALUE, over the files (a launch file's per-run setting)
   std::vector<std::string> channel_remaps;  // PORT=CHANNEL
   double status_period_s = 1.0;
   std::string status_channel;  // "" = STATUS_<NAME>
@@ -34,6 +35,9 @@ void addProcessOptions(CLI::App& app, ProcessOptions& options);
 
 // Reads and merges --config files in order (none = built-in defaults). Throws std::runtime_error.
 Config loadConfig(const std::vector<std::string>& paths);
+
+// Sets each KEY=VALUE over `config`; throws std::runtime_error on a malformed one.
+void applyConfigSets(Config& config, const std::vector<std::string>& sets);
 
 // Applies PORT=CHANNEL remaps; throws std::runtime_error on a malformed one or an unknown port.
 void applyRemaps(Node& node, const std::vector<std::string>& remaps);

@@ -6,6 +6,7 @@
 #include "launch/launch_file.hpp"
 #include "nodes/node_config.hpp"
 #include "nodes/registry.hpp"
+#include "runtime/process.hpp"
 #include "sim/simulator.hpp"
 
 #include <gtest/gtest.h>
@@ -83,7 +84,8 @@ TEST(ConfigFiles, LaunchFilesLoad) {
     if (path.string().find(".launch.yaml") == std::string::npos) continue;
     ++files;
     adit::launch::LaunchSpec spec;
-    const std::map<std::string, std::string> vars{{"LOG", "run.lcmlog"}, {"RUN_DIR", "run"}, {"ADIT_ROOT", ADIT_SOURCE_DIR}};
+    const std::map<std::string, std::string> vars{
+        {"LOG", "run.lcmlog"}, {"RUN_DIR", "run"}, {"ADIT_ROOT", ADIT_SOURCE_DIR}, {"PRIOR_MAP", "bundle"}};
     ASSERT_NO_THROW(spec = adit::launch::loadLaunchFile(path.string(), vars)) << path.filename();
     for (const auto& process : spec.processes)  // the configuration files its processes are given load too
       for (std::size_t i = 0; i + 1 < process.command.size(); ++i)
@@ -97,6 +99,17 @@ TEST(ConfigFiles, LaunchFilesLoad) {
 
 // `include:` and `defaults:` (the robot launch files build on live.launch.yaml): the included processes come
 // first, one of the same name is replaced, defaults yield to --set, and an include cycle is an error.
+// A process's --set KEY=VALUE goes over its --config files; a malformed one is an error.
+TEST(ProcessOptions, SetOverridesTheConfigFiles) {
+  adit::Config config = adit::Config::fromYamlString("reloc:\n  prior_map: old\n  query_distance: 0.5\n");
+  adit::runtime::applyConfigSets(config, {"reloc.prior_map=new/bundle", "reloc.mode=localise"});
+  EXPECT_EQ(config.values().at("reloc.prior_map"), "new/bundle");
+  EXPECT_EQ(config.values().at("reloc.query_distance"), "0.5");
+  EXPECT_EQ(config.values().at("reloc.mode"), "localise");
+  EXPECT_THROW(adit::runtime::applyConfigSets(config, {"reloc.prior_map"}), std::runtime_error);
+  EXPECT_THROW(adit::runtime::applyConfigSets(config, {"=x"}), std::runtime_error);
+}
+
 TEST(LaunchFiles, RobotFilesIncludeTheLivePipelineWithTheirSensor) {
   const std::map<std::string, std::string> vars{{"RUN_DIR", "run"}, {"ADIT_ROOT", ADIT_SOURCE_DIR}};
   const std::string dir = std::string(ADIT_SOURCE_DIR) + "/launch/";
@@ -124,6 +137,17 @@ TEST(LaunchFiles, RobotFilesIncludeTheLivePipelineWithTheirSensor) {
   } catch (const std::runtime_error& e) {
     EXPECT_NE(std::string(e.what()).find("nested"), std::string::npos) << e.what();
   }
+  // localise.launch.yaml: the live pipeline plus the relocaliser, told the bundle by --set; without
+  // PRIOR_MAP the file is refused rather than run without a map.
+  auto with_map = vars;
+  with_map["PRIOR_MAP"] = "saved/bundle";
+  const auto localise = adit::launch::loadLaunchFile(dir + "localise.launch.yaml", with_map);
+  ASSERT_EQ(localise.processes.size(), live.processes.size() + 1);
+  const auto& command = localise.processes.back().command;
+  EXPECT_EQ(command.front(), "adit-relocaliser");
+  EXPECT_EQ(command.back(), "reloc.prior_map=saved/bundle");
+  EXPECT_THROW(adit::launch::loadLaunchFile(dir + "localise.launch.yaml", vars), std::runtime_error);
+
   std::ofstream(tmp + "base.launch.yaml") << "name: base\nprocesses:\n  - {name: x, command: [sleep, '1']}\n  - {name: y, command: [true]}\n";
   std::ofstream(tmp + "over.launch.yaml") << "include: base.launch.yaml\nprocesses:\n  - {name: x, command: [sleep, '2']}\n";
   const auto over = adit::launch::loadLaunchFile(tmp + "over.launch.yaml", vars);

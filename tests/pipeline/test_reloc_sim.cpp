@@ -71,7 +71,7 @@ TEST(RelocaliseSim, SecondDriveStartingThirtyMetresInRelocalisesWithinTwentyCent
   const Drive second = drive(25.0, 30.0, "second", "", bundle);
   std::printf("%s", second.json.c_str());
   EXPECT_NE(second.json.find("\"state\": \"localised\""), std::string::npos);
-  ASSERT_GT(second.in_map.size(), 50u) << "relocalised too late or never";
+  ASSERT_GT(second.in_map.size(), 150u) << "relocalised too late (after 10 s of 25 s) or never";
 
   // The map frame is the first drive's estimate frame; its ground truth frame is anchored at the first sweep.
   const Eigen::Isometry3d T_world_map = first.ground_truth.front().pose * first.estimate.front().pose.inverse();
@@ -89,9 +89,9 @@ TEST(RelocaliseSim, SecondDriveStartingThirtyMetresInRelocalisesWithinTwentyCent
   const double fix_s = static_cast<double>(second.in_map.front().utime - second.ground_truth.front().utime) * 1e-6;
   std::printf("first fix after %.1f s; %zu poses in the map: APE RMSE %.3f m, worst %.3f m / %.2f deg\n", fix_s,
               second.in_map.size(), rmse, worst, worst_deg);
-  // Measured: first fix after 8.7 s (on this straight stretch a single sweep's fit is degenerate along the
-  // roadway and refused until the query sees more than arches and bolts), APE RMSE 0.113 m, worst 0.165 m /
-  // 0.96 deg.
+  // Measured: first fix after 6.7 s (8.7 s before the search along the roadway; on this stretch the search
+  // finds other places along the line nearly as good for the first seconds and refuses), APE RMSE 0.093 m,
+  // worst 0.144 m / 0.59 deg (0.113 m, 0.165 m / 0.96 deg before).
   EXPECT_LE(rmse, 0.2);
   EXPECT_LE(worst, 0.3);
   EXPECT_LE(worst_deg, 2.0);

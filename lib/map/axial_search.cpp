@@ -1,0 +1,137 @@
+#include "map/axial_search.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/LU>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+namespace adit {
+namespace {
+
+// The translation along which the fit is weakest (left perturbation: in the target frame), from the Hessian's
+// translation block with the rotation marginalised out; zero when a second translation is weak too (a
+// relative test) or a rotation is (its standard deviation at the fit's residual). The loop closer's scaled
+// eigenvalue test is not used here: it counts a roll about the roadway's axis as weak because its points are a
+// few metres, not its characteristic 10 m, from the axis, though floor and walls pin it.
+Eigen::Vector3d weakTranslation(const IcpResult& fit, const LoopVerifierConfig& verifier, const AxialSearchConfig& config) {
+  const Matrix6d& H = fit.hessian;
+  const Eigen::Matrix3d Htt = H.topLeftCorner<3, 3>(), Hrr = H.bottomRightCorner<3, 3>(), Htr = H.topRightCorner<3, 3>();
+  // The weak translation may be wholly unconstrained (nothing but repeats in view): a tiny ridge keeps the
+  // rotation's marginal finite there.
+  const Eigen::FullPivLU<Eigen::Matrix3d> rr(Hrr), tt(Htt + 1e-6 * Htt.trace() * Eigen::Matrix3d::Identity());
+  if (!rr.isInvertible() || !tt.isInvertible()) return Eigen::Vector3d::Zero();
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> trans(Htt - Htr * rr.solve(Htr.transpose()));
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> rot(Hrr - Htr.transpose() * tt.solve(Htr));
+  const double largest = trans.eigenvalues()[2];
+  if (largest <= 0.0 || trans.eigenvalues()[1] / largest < verifier.min_eigenvalue_ratio) return Eigen::Vector3d::Zero();
+  const double sigma = std::max(fit.rms, 0.01);
+  if (rot.eigenvalues()[0] <= 0.0 || sigma / std::sqrt(rot.eigenvalues()[0]) > config.max_rotation_sigma)
+    return Eigen::Vector3d::Zero();
+  return trans.eigenvectors().col(0).normalized();
+}
+
+struct Place {
+  IcpResult icp;
+  double along = 0.0;  // m along the weak direction from the degenerate fit
+};
+
+bool better(const Place& a, const Place& b) {
+  if (a.icp.inlier_ratio != b.icp.inlier_ratio) return a.icp.inlier_ratio > b.icp.inlier_ratio;
+  return a.icp.rms < b.icp.rms;
+}
+
+// ICP from seeds every config.step along `axis`, a few iterations each: the fits, best first.
+std::vector<Place> sweepLine(const PlaneTarget& target, const std::vector<Eigen::Vector3f>& source,
+                             const Eigen::Isometry3d& T_fit, const Eigen::Vector3d& axis, const IcpConfig& icp,
+                             const AxialSearchConfig& config) {
+  IcpConfig quick = icp;
+  quick.max_iterations = config.seed_iterations;
+  std::vector<Place> places;
+  const int n = static_cast<int>(std::floor(config.range / config.step));
+  for (int i = -n; i <= n; ++i) {
+    Eigen::Isometry3d seed = T_fit;
+    seed.pretranslate(axis * (i * config.step));
+    Place p;
+    p.icp = alignPointToPlane(target, source, seed, quick);
+    p.along = axis.dot(p.icp.T_target_source.translation() - T_fit.translation());
+    places.push_back(p);
+  }
+  std::stable_sort(places.begin(), places.end(), better);
+  return places;
+}
+
+// The best `count` places at least `separation` apart, each refined by the full ICP, best first.
+std::vector<Place> refineDistinct(const PlaneTarget& target, const std::vector<Eigen::Vector3f>& source,
+                                  const std::vector<Place>& places, const Eigen::Vector3d& axis,
+                                  const Eigen::Isometry3d& T_fit, const IcpConfig& icp, const AxialSearchConfig& config) {
+  std::vector<Place> distinct;
+  for (const Place& p : places) {
+    if (static_cast<int>(distinct.size()) >= config.refined) break;
+    const bool near = std::any_of(distinct.begin(), distinct.end(),
+                                  [&](const Place& d) { return std::abs(d.along - p.along) < config.separation; });
+    if (near) continue;
+    distinct.push_back(p);
+  }
+  for (Place& p : distinct) {
+    p.icp = alignPointToPlane(target, source, p.icp.T_target_source, icp);
+    p.along = axis.dot(p.icp.T_target_source.translation() - T_fit.translation());
+  }
+  std::stable_sort(distinct.begin(), distinct.end(), better);
+  return distinct;
+}
+
+}  // namespace
+
+const ConfigTable<AxialSearchConfig>& axialSearchConfigTable() {
+  using A = AxialSearchConfig;
+  static const ConfigTable<A> table = [] {
+    ConfigTable<A> t("reloc.axial");
+    t.add("enabled", &A::enabled, anyValue(), "", "search a fit that is tight but weak along one translation (a straight roadway) along that direction")
+     .add("range", &A::range, above(0), "m", "searched on each side of the weak fit")
+     .add("step", &A::step, above(0), "m", "between the seeds of the search")
+     .add("seed_iterations", &A::seed_iterations, between(1, 100), "", "ICP iterations per phase from each seed")
+     .add("refined", &A::refined, between(1, 100), "", "best distinct places refined by the full ICP")
+     .add("separation", &A::separation, above(0), "m", "fits farther apart along the line are different places")
+     .add("min_inlier_ratio", &A::min_inlier_ratio, between(0, 1), "", "the best fit's share of inliers")
+     .add("margin", &A::margin, between(0, 1), "", "inlier ratio the best fit must have over the best fit elsewhere on the line")
+     .add("max_rotation_sigma", &A::max_rotation_sigma, above(0), "rad", "standard deviation of the least constrained rotation of a fit at its residual");
+    return t;
+  }();
+  return table;
+}
+
+AxialSearchResult searchWeakDirection(const PlaneTarget& target, const std::vector<Eigen::Vector3f>& source,
+                                      const IcpResult& fit, const LoopVerifierConfig& verifier,
+                                      const AxialSearchConfig& config) {
+  AxialSearchResult out;
+  const Eigen::Vector3d axis = weakTranslation(fit, verifier, config);
+  if (axis.isZero()) {
+    out.refusal = "weak";
+    return out;
+  }
+  out.axis = axis;
+  const Eigen::Isometry3d T_fit = fit.T_target_source;
+  const std::vector<Place> line = sweepLine(target, source, T_fit, axis, verifier.icp, config);
+  const std::vector<Place> places = refineDistinct(target, source, line, axis, T_fit, verifier.icp, config);
+  if (places.empty()) return out;
+  const Place& best = places.front();
+  out.icp = best.icp;
+  out.T_target_source = best.icp.T_target_source;
+  // Elsewhere: the refined places and, stricter still, the seeds' own (less converged) fits.
+  for (const std::vector<Place>* list : {&places, &line})
+    for (const Place& p : *list)
+      if (std::abs(p.along - best.along) >= config.separation) out.runner_up = std::max(out.runner_up, p.icp.inlier_ratio);
+  if (!fitsTightly(best.icp, verifier) || !best.icp.converged || best.icp.inlier_ratio < config.min_inlier_ratio)
+    out.refusal = "loose";
+  else if (weakTranslation(best.icp, verifier, config).isZero())
+    out.refusal = "weak";
+  else if (best.icp.inlier_ratio - out.runner_up < config.margin)
+    out.refusal = "ambiguous";
+  else
+    out.resolved = true;
+  return out;
+}
+
+}  // namespace adit
