@@ -58,7 +58,8 @@ ConfigTable<L> loamTable() {
    .add("occlusion_ratio", &L::occlusion_ratio, above(0), "", "range jump (fraction of the nearer range) whose far side is occluded")
    .add("parallel_ratio", &L::parallel_ratio, above(0), "", "range change to both neighbours (fraction) of a surface nearly parallel to the beam")
    .add("max_neighbor_gap_deg", &L::max_neighbor_gap_deg, aboveUpTo(0, 180), "deg", "a larger azimuth gap between ring neighbours breaks the window")
-   .add("less_flat_voxel", &L::less_flat_voxel, between(0.01, 10), "m", "voxel leaf of the less-flat points (A-LOAM: 0.2)");
+   .add("less_flat_voxel", &L::less_flat_voxel, between(0.01, 10), "m", "voxel leaf of the less-flat points (A-LOAM: 0.2)")
+   .add("less_flat_measured", &L::less_flat_measured, anyValue(), "", "a less-flat voxel keeps the measured point nearest its centre, not the centroid (A-LOAM: false)");
   return t;
 }
 

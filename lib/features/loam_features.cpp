@@ -114,7 +114,7 @@ LoamFeatures selectLoamFeatures(const RingCloud& c, const PointScores& s, const 
   std::vector<std::uint64_t> edges, flats;
   // Less flat points go straight into the voxel grid (no copy of them all first); a leaf <= 0 keeps them all.
   const bool downsample = cfg.less_flat_voxel > 0.0f;
-  VoxelCentroids grid(downsample ? cfg.less_flat_voxel : 1.0f, c.points.size());
+  VoxelCentroids grid(downsample ? cfg.less_flat_voxel : 1.0f, c.points.size(), cfg.less_flat_measured);
   const int sectors = std::max(1, cfg.sectors);
   for (int r = 0; r < c.numRings(); ++r) {
     const int b = c.ring_begin[r], e = c.ring_begin[r + 1];
@@ -125,11 +125,16 @@ LoamFeatures selectLoamFeatures(const RingCloud& c, const PointScores& s, const 
       sel.sector(sp0 + (ep0 - sp0) * k / sectors, sp0 + (ep0 - sp0) * (k + 1) / sectors, out);
     for (int i = sp0; i < ep0; ++i)
       if (s.usable[i] && label[i] != kEdge && !sel.isEdge(i)) {
-        if (downsample) grid.add(c.points[i]);
-        else out.less_flat.push_back(c.points[i]);
+        // Measured less-flat points include every flat point (as LOAM defines the set), so a flat point
+        // of the next sweep can find its own surface point rather than a neighbour's plane.
+        if (!downsample || (cfg.less_flat_measured && label[i] == kFlat)) out.less_flat.push_back(c.points[i]);
+        else grid.add(c.points[i]);
       }
   }
-  if (downsample) out.less_flat = grid.take();
+  if (downsample) {
+    std::vector<LidarPoint> sampled = grid.take();
+    out.less_flat.insert(out.less_flat.end(), sampled.begin(), sampled.end());
+  }
   return out;
 }
 

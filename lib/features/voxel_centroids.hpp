@@ -1,5 +1,8 @@
-// Voxel downsampling as a streaming accumulator: points go in one by one, one centroid per occupied voxel
-// comes out, in order of first occurrence (deterministic: the hash table is used for lookups only).
+// Voxel downsampling as a streaming accumulator: points go in one by one, one point per occupied voxel comes
+// out, in order of first occurrence (deterministic: the hash table is used for lookups only). The point is the
+// voxel's centroid, or (keep_measured) the measured point nearest the voxel's centre: a centroid of points on
+// a curved surface, or of two rings' points at different depths, lies off the surface, and a registration
+// against such points is biased (issue 16: scan-to-scan odometry drifted at rest).
 #pragma once
 
 #include "core/types.hpp"
@@ -13,13 +16,17 @@ namespace adit::features {
 class VoxelCentroids {
  public:
   // leaf: voxel size (m), > 0. expected_points: a hint for the first table size (the table grows as needed).
-  VoxelCentroids(float leaf, std::size_t expected_points);
+  VoxelCentroids(float leaf, std::size_t expected_points, bool keep_measured = false);
 
   // Adds p to its voxel. Points with non-finite or absurd coordinates (a hostile message) have no voxel
   // and are skipped: converting them to integers would be undefined.
   void add(const LidarPoint& p) {
     std::uint64_t key;
     if (!voxelKey(p.p, key)) return;
+    if (keep_measured_) {
+      keepNearestToCentre(key, p);
+      return;
+    }
     if (last_voxel_ >= 0 && key == last_key_) {  // inline: the common case
       out_[static_cast<std::size_t>(last_voxel_)].p += p.p;
       ++counts_[static_cast<std::size_t>(last_voxel_)];
@@ -28,7 +35,8 @@ class VoxelCentroids {
     addToOtherVoxel(key, p);
   }
 
-  // One point per voxel at the centroid of its points, with the ring / time / intensity of the first.
+  // One point per voxel: at the centroid of its points, with the ring / time / intensity of the first; or
+  // (keep_measured) the point nearest the voxel's centre, as it was measured.
   std::vector<LidarPoint> take();
 
  private:
@@ -49,15 +57,30 @@ class VoxelCentroids {
     return true;
   }
   void addToOtherVoxel(std::uint64_t key, const LidarPoint& p);
+  // The voxel of key (last_voxel_ updated), or a new one holding p (then `added` is true).
+  std::int32_t voxelOf(std::uint64_t key, const LidarPoint& p, bool& added);
+  void keepNearestToCentre(std::uint64_t key, const LidarPoint& p);
+  // Squared distance of p from its voxel's centre, in leaves.
+  float squaredFromCentre(const Eigen::Vector3f& p) const {
+    float sq = 0.0f;
+    for (int i = 0; i < 3; ++i) {
+      const float v = p[i] * inv_leaf_;
+      const float d = v - static_cast<float>(floorToInt(v)) - 0.5f;
+      sq += d * d;
+    }
+    return sq;
+  }
   void grow();
   std::size_t bucket(std::uint64_t key) const { return static_cast<std::size_t>((key * 0x9E3779B97F4A7C15ull) >> shift_); }
 
   float inv_leaf_;
+  bool keep_measured_ = false;
   int shift_ = 64;                    // bucket = top bits of the multiplied key
   std::vector<std::int32_t> table_;   // bucket -> voxel index, -1 = empty (open addressing, linear probing)
   std::vector<std::uint64_t> keys_;   // per voxel: packed integer coordinates
   std::vector<LidarPoint> out_;       // per voxel: first point, its position holding the running sum
   std::vector<std::int32_t> counts_;  // per voxel: points summed
+  std::vector<float> from_centre_;    // per voxel (keep_measured): squared distance of the kept point
   std::uint64_t last_key_ = 0;        // consecutive points of a ring mostly share a voxel: skip the lookup
   std::int32_t last_voxel_ = -1;
 };

@@ -121,7 +121,11 @@ adit::features_t toMessage(const FeatureSet& f) {
   m.sweep_duration = f.cloud.sweep_duration;
   m.sweep_flags = sweepFlags(f.cloud);
   // Times only for a raw sweep: registration compensates it with them; a deskewed one needs none.
-  const PointSetFields loam{true, !f.cloud.deskewed};
+  // One grid for the LOAM sets: the odometry matches flat / sharp points against the less-flat / less-sharp
+  // sets that contain them.
+  const float loam_scale = std::max({pointSetScale(f.corner_sharp), pointSetScale(f.corner_less_sharp),
+                                     pointSetScale(f.surf_flat), pointSetScale(f.surf_less_flat)});
+  const PointSetFields loam{true, !f.cloud.deskewed, loam_scale};
   m.corner_sharp = toPointSet(f.corner_sharp, loam);
   m.corner_less_sharp = toPointSet(f.corner_less_sharp, loam);
   m.surf_flat = toPointSet(f.surf_flat, loam);

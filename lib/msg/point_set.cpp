@@ -29,17 +29,20 @@ adit::point_set_t emptyPointSet() {
   return s;
 }
 
+float pointSetScale(const std::vector<LidarPoint>& points) {
+  float largest = 0.0f;
+  for (const LidarPoint& p : points)
+    if (p.p.allFinite()) largest = std::max(largest, p.p.cwiseAbs().maxCoeff());
+  return std::max(kPointSetScale, largest / 32767.0f);
+}
+
 adit::point_set_t toPointSet(const std::vector<LidarPoint>& points, PointSetFields fields) {
   adit::point_set_t s = emptyPointSet();
   std::vector<const LidarPoint*> kept;
   kept.reserve(points.size());
-  float largest = 0.0f;
-  for (const LidarPoint& p : points) {
-    if (!p.p.allFinite()) continue;
-    kept.push_back(&p);
-    largest = std::max(largest, p.p.cwiseAbs().maxCoeff());
-  }
-  s.scale = std::max(kPointSetScale, largest / 32767.0f);
+  for (const LidarPoint& p : points)
+    if (p.p.allFinite()) kept.push_back(&p);
+  s.scale = std::max(pointSetScale(points), fields.min_scale);
   const std::size_t n = kept.size();
   s.num_points = static_cast<std::int32_t>(n);
   s.x.resize(n);

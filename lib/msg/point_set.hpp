@@ -17,7 +17,14 @@ constexpr float kPointSetScale = 0.001f;
 struct PointSetFields {
   bool rings = false;  // the consumer matches by ring (LOAM sets)
   bool times = false;  // the sweep is not deskewed: the consumer compensates with dt
+  // At least this scale: sets of one message that are matched against each other (a sweep's flat points and
+  // less-flat points, which contain them) must share one grid, or the same point is quantised to two
+  // places up to a scale apart, an offset fixed to the sensor that biased scan-to-scan odometry (issue 16).
+  float min_scale = 0.0f;
 };
+
+// The scale toPointSet gives these points on their own (m per count).
+float pointSetScale(const std::vector<LidarPoint>& points);
 
 adit::point_set_t toPointSet(const std::vector<LidarPoint>& points, PointSetFields fields);
 // Points with intensity 0; ring and dt 0 where the set does not carry them. Non-finite or non-positive scale

@@ -31,6 +31,7 @@ ScanToScanConfig aloamOdometryConfig() {
   s.use_link3d_seed = false;
   s.line_min_rings = 2;
   s.three_point_planes = true;
+  s.plane_through_nearest = false;
   s.compensate_mixed_deskew = false;
   s.outer_iterations = 2;
   s.registration.max_solver_iterations = 4;
@@ -62,6 +63,7 @@ const ConfigTable<ScanToScanConfig>& scanToScanConfigTable() {
      .add("line_eigen_ratio", &S::line_eigen_ratio, atLeast(1), "", "line if the largest PCA eigenvalue exceeds ratio * the second")
      .add("line_max_point_distance_m", &S::line_max_point_distance_m, above(0), "m", "a line is rejected if a point is farther from it")
      .add("three_point_planes", &S::three_point_planes, anyValue(), "", "A-LOAM's unchecked three-point planes (ablation only)")
+     .add("plane_through_nearest", &S::plane_through_nearest, anyValue(), "", "a surface match's plane passes through the nearest previous point, not the neighbours' centroid")
      .add("ring_neighbours", &S::ring_neighbours, between(0, 100), "points", "nearest points per ring added to a plane fit")
      .add("compensate_mixed_deskew", &S::compensate_mixed_deskew, anyValue(), "", "move a raw sweep to its end instant when its neighbour is deskewed")
      .add("use_link3d_seed", &S::use_link3d_seed, anyValue(), "", "seed from LinK3D matches (false: motion model only, A-LOAM)")
@@ -194,7 +196,9 @@ std::optional<PlaneFit> ScanToScanOdometry::fitLocalPlane(const Eigen::Vector3d&
     several_rings = several_rings || previous_->surfs.ring(i) != ring;
   }
   if (!several_rings) return std::nullopt;
-  return fitPlane(pts, config_.plane_max_point_distance_m);
+  auto plane = fitPlane(pts, config_.plane_max_point_distance_m);
+  if (plane && config_.plane_through_nearest) plane->offset = -plane->normal.dot(pts.front());
+  return plane;
 }
 
 Correspondences ScanToScanOdometry::match(const std::vector<LidarPoint>& sharp, const std::vector<LidarPoint>& flat,

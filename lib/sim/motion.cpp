@@ -54,6 +54,7 @@ MotionConfig motionConfigFrom(const adit::Config& cfg) {
   c.wander = cfg.get(p + "wander", c.wander);
   c.start_still = cfg.get(p + "start_still", c.start_still);
   c.start_speed = cfg.get(p + "start_speed", c.start_speed);
+  c.stationary = cfg.get(p + "stationary", c.stationary);
   c.start_distance = cfg.get(p + "start_distance", c.start_distance);
   c.reverse = cfg.get(p + "reverse", c.reverse);
   c.mount_height = cfg.get(p + "mount_height", c.mount_height);
@@ -61,6 +62,7 @@ MotionConfig motionConfigFrom(const adit::Config& cfg) {
   c.track_width = cfg.get(p + "track_width", c.track_width);
   c.vibration_deg = cfg.get(p + "vibration_deg", c.vibration_deg);
   c.bounce = cfg.get(p + "bounce", c.bounce);
+  c.idle_vibration = cfg.get(p + "idle_vibration", c.idle_vibration);
   c.vibration_min_hz = cfg.get(p + "vibration_min_hz", c.vibration_min_hz);
   c.vibration_max_hz = cfg.get(p + "vibration_max_hz", c.vibration_max_hz);
   c.knot_spacing = cfg.get(p + "knot_spacing", c.knot_spacing);
@@ -225,9 +227,15 @@ PlannedMotion planMotion(const World& world, const MotionConfig& c, double durat
   const Path2d path(waypoints, c.corner_radius);
   // The smoothing below reaches smoothing_window back in time: start moving that much later so the robot is
   // exactly still for start_still seconds. A robot already moving starts at once.
-  const bool moving_start = c.start_speed > 0.0;
-  const SpeedPlan plan(path, speedProfile(path, c, !world.route_closed, rng),
-                       moving_start ? 0.0 : c.start_still + std::max(0.0, c.smoothing_window));
+  // A stationary robot's motion starts after the horizon (the profile still draws its random numbers, so the
+  // wander and vibration below are those of the same seed's drive).
+  MotionConfig profile_config = c;
+  if (c.stationary) profile_config.start_speed = 0.0;
+  const bool moving_start = profile_config.start_speed > 0.0;
+  const double start_time = c.stationary ? 2.0 * horizon + std::max(0.0, c.smoothing_window)
+                            : moving_start ? 0.0
+                                           : c.start_still + std::max(0.0, c.smoothing_window);
+  const SpeedPlan plan(path, speedProfile(path, profile_config, !world.route_closed, rng), start_time);
   const double w1 = rng.uniform(20.0, 35.0), w2 = rng.uniform(45.0, 80.0);
   const double q1 = rng.uniform(0.0, 2 * M_PI), q2 = rng.uniform(0.0, 2 * M_PI);
   auto wander = [&](double s) {
@@ -267,7 +275,7 @@ PlannedMotion planMotion(const World& world, const MotionConfig& c, double durat
   for (int k = 0; k < controls; ++k) {
     const double t = knotTime(k);
     const GroundContact ground = trackPlane(world, {xs[k], ys[k]}, yaws[k], c);
-    const double scale = std::min(1.5, speeds[k] / 1.0);
+    const double scale = std::max(c.idle_vibration, std::min(1.5, speeds[k] / 1.0));
     const double sigma = c.vibration_deg * kDegToRad * scale;
     const Eigen::Matrix3d R =
         (Eigen::AngleAxisd(yaws[k] + sigma / 3 * vibration.value(2, t), Eigen::Vector3d::UnitZ()) *

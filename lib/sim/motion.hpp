@@ -11,8 +11,9 @@
 //    change continuously, as a real vehicle's do;
 //  - height, pitch and roll from a plane fitted to the floor under the two tracks (so pitch/roll really come from
 //    the rugged floor; bumps shorter than the tracks are bridged), plus chassis vibration in pitch, roll, yaw and height: per axis a sum of 3 sinusoids with
-//    seeded frequencies in [vibration_min_hz, vibration_max_hz] (amplitude ~ 1/f), scaled by speed, so it is
-//    band-limited like a real chassis and its accelerations stay physical;
+//    seeded frequencies in [vibration_min_hz, vibration_max_hz] (amplitude ~ 1/f), scaled by speed (never below
+//    idle_vibration: an idling engine), so it is band-limited like a real chassis and its accelerations stay physical;
+//  - or, with stationary, no motion at all: the robot stands at the route's start for the whole run;
 //  - the lidar sits mount_height above the ground on the body z axis; the IMU is at the lidar (identity extrinsic).
 // The resulting poses are sampled every knot_spacing seconds and become the control points of the spline; the
 // spline IS the ground truth (its derivatives feed the IMU).
@@ -38,6 +39,9 @@ struct MotionConfig {
   double wander = 0.15;          // m, amplitude of the lateral wander around the centre line
   double start_still = 2.0;      // s standing still at the start (ignored when start_speed > 0)
   double start_speed = 0.0;      // m/s already driven at time 0 (capped by the speed limits there); 0 = from rest
+  // The robot never moves: it stands at its start pose for the whole run (start_still and start_speed ignored):
+  // for measuring what the estimate does at rest (issue 16).
+  bool stationary = false;
   // Where on the route the drive starts (m along it; closed routes wrap round, open ones drop what lies before)
   // and in which direction: a later drive through a mapped roadway that starts somewhere else (issue 18).
   double start_distance = 0.0;
@@ -47,6 +51,8 @@ struct MotionConfig {
   double track_width = 0.8;      // m, distance between the tracks (roll from the floor)
   double vibration_deg = 0.3;    // deg RMS pitch/roll vibration at 1 m/s (yaw gets a third of it)
   double bounce = 0.004;         // m RMS vertical vibration at 1 m/s
+  // Vibration while standing (engine idling), as a fraction of the vibration at 1 m/s; 0 = none at rest.
+  double idle_vibration = 0.0;
   double vibration_min_hz = 0.8; // chassis vibration band (Hz)
   double vibration_max_hz = 4.0;
   double knot_spacing = 0.02;    // s between spline control points (>= 12 knots per vibration period)

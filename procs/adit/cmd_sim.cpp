@@ -18,7 +18,7 @@ struct SimArgs {
   std::vector<std::string> configs;
   std::string world, sensor, output, gt, world_pcd, lcm_url, pcap, bag, bag_compression = "none";
   double duration_s = -1, rate = 1.0, world_spacing = 0.1, start_speed = -1, start_distance = -1;
-  bool reverse = false;
+  bool reverse = false, stationary = false;
   std::int64_t seed = -1;
   bool live = false, no_truth_channel = false, no_imu = false;
   std::string stall_lidar, stall_imu;
@@ -100,6 +100,9 @@ void registerSimCommand(CLI::App& app) {
                   "Start this far (m) along the world's route (sim.motion.start_distance): a later drive through "
                   "the same roadway")->check(CLI::NonNegativeNumber);
   cmd->add_flag("--reverse", a->reverse, "Drive the route backwards (sim.motion.reverse)");
+  cmd->add_flag("--stationary", a->stationary,
+                "The robot stands still at the route's start for the whole run (sim.motion.stationary; "
+                "sim.motion.idle_vibration: chassis vibration at rest)");
   cmd->add_flag("--no-imu", a->no_imu, "Publish no IMU (a vehicle without one)");
   cmd->add_option("--stall-lidar", a->stall_lidar,
                   "Fault test: publish no LIDAR_POINTS (nor their GROUND_TRUTH) from START for SECONDS of sensor "
@@ -115,6 +118,7 @@ void registerSimCommand(CLI::App& app) {
     if (a->start_speed >= 0) config.motion.start_speed = a->start_speed;
     if (a->start_distance >= 0) config.motion.start_distance = a->start_distance;
     if (a->reverse) config.motion.reverse = true;
+    if (a->stationary) config.motion.stationary = true;
 
     adit::sources::SimChannels channels;
     if (a->no_truth_channel) channels.ground_truth.clear();

@@ -21,6 +21,7 @@ namespace adit::test {
 
 struct SimPipelineRun {
   Trajectory ground_truth, odometry, corrected;
+  Trajectory scan_odometry;  // ODOM_SCAN: scan-to-scan odometry alone (SimPipelineSetup::scan_odometry)
   std::vector<LoopConstraint> loops;
   int false_loops = 0;
   double worst_loop_error_m = 0, worst_loop_error_deg = 0;
@@ -34,6 +35,7 @@ constexpr double kFalseLoopDegrees = 5.0;
 struct SimPipelineSetup {
   std::function<void(sim::SimConfig&)> adjust;  // e.g. motion.start_speed
   bool imu = true;                              // false: the simulator publishes no IMU
+  bool scan_odometry = false;                   // also collect ODOM_SCAN's poses (SimPipelineRun::scan_odometry)
 };
 
 inline SimPipelineRun runSimPipeline(const std::string& world, double duration_s, std::uint64_t seed,
@@ -59,6 +61,7 @@ inline SimPipelineRun runSimPipeline(const std::string& world, double duration_s
                         .string();
   options.config = config;
   options.record = "^LOOP_CLOSURE$";
+  if (setup.scan_odometry) options.record_poses = "^ODOM_SCAN$";
   pipeline::runReplay(options);
 
   SimPipelineRun run;
@@ -68,6 +71,12 @@ inline SimPipelineRun runSimPipeline(const std::string& world, double duration_s
   runtime::LogReader log(options.out_dir + "/output.lcmlog");
   runtime::LogEvent e;
   while (log.next(e)) {
+    adit::odometry_t scan;
+    if (e.channel == "ODOM_SCAN" && scan.decode(e.data.data(), 0, static_cast<int>(e.data.size())) >= 0) {
+      const PoseEstimate pose = msg::fromMessage(scan);
+      run.scan_odometry.push_back({pose.utime, pose.pose});
+      continue;
+    }
     adit::loop_closure_t m;
     if (e.channel != "LOOP_CLOSURE" || m.decode(e.data.data(), 0, static_cast<int>(e.data.size())) < 0) continue;
     const LoopConstraint loop = msg::fromMessage(m);

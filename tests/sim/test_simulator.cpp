@@ -206,6 +206,35 @@ TEST(SimulatorMotion, StartsAtTheConfiguredSpeed) {
   EXPECT_LT(still.trajectory().state(1.0).velocity.norm(), 1e-9);
 }
 
+// sim.motion.stationary: the robot never leaves its start pose, however long the run; idle_vibration shakes it
+// there (pitch/roll around the rest attitude) without moving it away.
+TEST(SimulatorMotion, StationaryStandsStill) {
+  SimConfig c = shortRun("roadway-loop", 3);
+  c.duration_s = 30.0;
+  c.motion.stationary = true;
+  c.motion.start_speed = 1.5;  // ignored when stationary
+  const Simulator still(c);
+  const Eigen::Isometry3d start = still.groundTruth(still.sweepUtime(0)).pose;
+  for (const double t : {0.0, 5.0, 29.9}) {
+    const TrajectoryState s = still.trajectory().state(t);
+    EXPECT_LT(s.velocity.norm(), 1e-9) << t;
+    EXPECT_LT(s.angular_velocity.norm(), 1e-9) << t;
+    EXPECT_TRUE(s.pose.isApprox(start, 1e-12)) << t;
+  }
+  c.motion.idle_vibration = 0.5;
+  const Simulator idling(c);
+  double worst_deg = 0.0, worst_m = 0.0;
+  for (double t = 0.0; t < 30.0; t += 0.05) {
+    const Eigen::Isometry3d d = start.inverse() * idling.trajectory().state(t).pose;
+    worst_deg = std::max(worst_deg, Eigen::AngleAxisd(d.linear()).angle() * 180.0 / M_PI);
+    worst_m = std::max(worst_m, d.translation().norm());
+  }
+  // 0.5 x 0.3 deg RMS (sum of 3 tones: peaks up to ~2.5 x RMS); the mast turns that into ~1 m x angle.
+  EXPECT_GT(worst_deg, 0.05);
+  EXPECT_LT(worst_deg, 0.6);
+  EXPECT_LT(worst_m, 0.02);
+}
+
 TEST(SimulatorConfig, KeysAndErrors) {
   adit::Config cfg;
   cfg.set("sim.world", "featureless");
@@ -265,6 +294,7 @@ TEST(SimulatorConfig, ReferenceWorldFileMatchesTheDefaults) {
            {c.motion.corner_radius, d.motion.corner_radius}, {c.motion.wander, d.motion.wander},
            {c.motion.start_still, d.motion.start_still}, {c.motion.start_speed, d.motion.start_speed},
            {c.motion.start_distance, d.motion.start_distance}, {double(c.motion.reverse), double(d.motion.reverse)},
+           {double(c.motion.stationary), double(d.motion.stationary)}, {c.motion.idle_vibration, d.motion.idle_vibration},
            {c.motion.mount_height, d.motion.mount_height},
            {c.motion.track_length, d.motion.track_length}, {c.motion.track_width, d.motion.track_width},
            {c.motion.vibration_deg, d.motion.vibration_deg}, {c.motion.bounce, d.motion.bounce},
