@@ -29,6 +29,7 @@ void putScanContext(ByteWriter& w, const ScanContext& sc) {
 
 std::optional<ScanContext> getScanContext(ByteReader& r) {
   const int rings = r.get<std::int32_t>(), sectors = r.get<std::int32_t>(), radius = r.get<std::int32_t>();
+  if (r.ok() && rings == 0 && sectors == 0 && radius >= 0) return ScanContext();  // a keyframe with no place context
   // Sizes are checked against the bytes left before anything is allocated.
   if (!r.ok() || rings <= 0 || sectors <= 0 || rings > 1000 || sectors > 1000 || radius < 0 ||
       static_cast<std::uint64_t>(rings) * static_cast<std::uint64_t>(sectors) * 4 > r.left()) {

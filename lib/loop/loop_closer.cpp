@@ -43,9 +43,17 @@ LoopCloser::Result LoopCloser::process(const PoseEstimate& mapped, const LidarSc
     if (config_.use_mapper_covariance && isValidCovariance(mapped.covariance) && !isUnsetCovariance(mapped.covariance))
       sweeps_since_keyframe_.emplace_back(mapped.pose, mapped.covariance);
     if (isKeyframe(mapped.pose)) {
-      addKeyframe(mapped, cloud);
+      const ScanContext context = addKeyframe(mapped, cloud);
+      const int k = static_cast<int>(keyframes_.size()) - 1;
+      const bool revisit = isRevisit(k);
+      // Empty contexts never match: a revisit keyframe is not a place later queries can find.
+      database_.add(revisit ? ScanContext() : context, mapped.utime);
       result.keyframe_added = true;
-      submitJob(static_cast<int>(keyframes_.size()) - 1);
+      submitJob(k, context);  // the job keeps its own copy of the cloud
+      if (revisit) {
+        keyframes_.back().cloud = CompactCloud::encode({}, static_cast<float>(config_.keyframe_cloud_step));
+        ++stats_.revisit_keyframes;
+      }
     }
     applyDue(mapped.utime, false, result);
   }
@@ -61,9 +69,8 @@ LoopCloser::Result LoopCloser::finish() {
 }
 
 // A snapshot of what verifying the query's candidates needs, posted as a job (loop/loop_job.hpp).
-void LoopCloser::submitJob(int query) {
+void LoopCloser::submitJob(int query, const ScanContext& context) {
   if (query - last_loop_query_ < config_.cooldown_keyframes) return;  // the job's book can only be later
-  const ScanContext& context = database_.context(query);
   if (context.empty()) return;
   const Keyframe& q = keyframes_[static_cast<std::size_t>(query)];
   const std::int64_t latest = q.utime - static_cast<std::int64_t>(config_.exclude_recent_seconds * 1e6);
@@ -165,7 +172,24 @@ Matrix6d LoopCloser::stepCovariance(const Eigen::Isometry3d& new_pose) const {
   return sigma;
 }
 
-void LoopCloser::addKeyframe(const PoseEstimate& mapped, const LidarScan& cloud) {
+// A place already mapped by an older keyframe that keeps its cloud, reached by a trajectory that a recent loop
+// ties to that older map (without the loop, drift could put an unmapped place near an old keyframe).
+bool LoopCloser::isRevisit(int keyframe) const {
+  if (config_.revisit_distance <= 0 || accepted_.empty() ||
+      accepted_.back().query_index < keyframe - config_.revisit_trust_keyframes)
+    return false;
+  const Eigen::Vector3d here = graph_.pose(keyframe).translation();
+  const int older_than = keyframe - config_.exclude_recent_keyframes;
+  for (int j = 0; j < older_than; ++j) {
+    if (!keyframes_[static_cast<std::size_t>(j)].cloud.empty() &&
+        (graph_.pose(j).translation() - here).norm() < config_.revisit_distance)
+      return true;
+  }
+  return false;
+}
+
+// Adds the keyframe's cloud and graph node; returns its Scan Context (the caller adds it to the database).
+ScanContext LoopCloser::addKeyframe(const PoseEstimate& mapped, const LidarScan& cloud) {
   std::vector<Eigen::Vector3f> points;
   points.reserve(cloud.points.size());
   for (const LidarPoint& p : cloud.points)
@@ -189,11 +213,9 @@ void LoopCloser::addKeyframe(const PoseEstimate& mapped, const LidarScan& cloud)
     graph_.addOdometryEdge(prev, id, step, covariance.inverse());
   }
   sweeps_since_keyframe_.clear();
-
-  database_.add(keyframeScanContext(std::move(points), mapped.pose, config_.level_scan_context, config_.scan_context),
-                kf.utime);
   keyframes_.push_back(std::move(kf));
   ++stats_.keyframes;
+  return keyframeScanContext(std::move(points), mapped.pose, config_.level_scan_context, config_.scan_context);
 }
 
 Eigen::Isometry3d LoopCloser::correction(int keyframe) const {
@@ -230,6 +252,7 @@ std::vector<Eigen::Vector3f> LoopCloser::correctedMap(double voxel) const {
   std::optional<VoxelAccumulator> grid;
   if (voxel > 0) grid.emplace(voxel);
   for (std::size_t k = 0; k < keyframes_.size(); ++k) {
+    if (keyframes_[k].cloud.empty()) continue;  // a revisit: its place is in an older keyframe's cloud
     const Eigen::Isometry3f T = graph_.pose(static_cast<int>(k)).cast<float>();
     for (const Eigen::Vector3f& p : keyframes_[k].cloud.decode()) {
       if (grid) {

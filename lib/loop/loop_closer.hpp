@@ -51,6 +51,15 @@ struct LoopCloserConfig {
   double exclude_recent_seconds = 30.0;   // nor those from the last T seconds (a robot standing still)
   int cooldown_keyframes = 3;             // after an accepted loop, skip detection for this many keyframes
 
+  // --- revisits: memory bounded by the roadway mapped, not by the time driven ---
+  // A keyframe within revisit_distance (corrected poses) of an older keyframe that keeps its cloud, while a loop
+  // accepted within the last revisit_trust_keyframes keyframes ties the trajectory to that older part of the map,
+  // keeps only its pose-graph node: its cloud and Scan Context serve its own loop search, then are dropped. The
+  // map of a place is its first visit's. A robot patrolling a mapped roadway for hours then adds a graph node
+  // (< 1 kB) per keyframe instead of ~40 kB. 0 keeps every keyframe's cloud.
+  double revisit_distance = 1.0;
+  int revisit_trust_keyframes = 30;
+
   // --- scheduling (loop/loop_job.hpp) ---
   // Verification and graph optimisation run as a job; its outcome is applied at the first sweep this much
   // sensor time after the keyframe (0: within the same sweep, the single-threaded schedule). The output
@@ -103,6 +112,7 @@ struct LoopCloserStats {
   int pending = 0;             // verified loops waiting for a consistent partner
   int accepted = 0;
   int optimizations = 0;
+  int revisit_keyframes = 0;   // keyframes that kept only their graph node (revisit_distance)
 };
 
 class LoopScheduler;
@@ -164,9 +174,10 @@ class LoopCloser {
 
  private:
   bool isKeyframe(const Eigen::Isometry3d& pose) const;
-  void addKeyframe(const PoseEstimate& mapped, const LidarScan& cloud);
+  ScanContext addKeyframe(const PoseEstimate& mapped, const LidarScan& cloud);
+  bool isRevisit(int keyframe) const;
   Matrix6d stepCovariance(const Eigen::Isometry3d& new_pose) const;
-  void submitJob(int query);
+  void submitJob(int query, const ScanContext& context);
   void applyDue(std::int64_t utime, bool all, Result& result);
   LoopScheduler& scheduler();
 

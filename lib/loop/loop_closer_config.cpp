@@ -64,6 +64,8 @@ const ConfigTable<LoopCloserConfig>& loopCloserConfigTable() {
      .add("exclude_recent_keyframes", &K::exclude_recent_keyframes, between(0, 1000000), "keyframes", "never match the newest N keyframes")
      .add("exclude_recent_seconds", &K::exclude_recent_seconds, atLeast(0), "s", "nor those from the last T seconds")
      .add("cooldown_keyframes", &K::cooldown_keyframes, between(0, 1000000), "keyframes", "after an accepted loop, skip detection this long")
+     .add("revisit_distance", &K::revisit_distance, atLeast(0), "m", "a keyframe this close to an older one, on a trajectory a recent loop ties to it, keeps only its graph node (0: off)")
+     .add("revisit_trust_keyframes", &K::revisit_trust_keyframes, between(0, 1000000), "keyframes", "how recent that loop must be")
      .add("apply_delay_s", &K::apply_delay_s, between(0, 3600), "s", "a loop job's outcome is applied at the first sweep this much later (0: same sweep)")
      .add("worker_thread", &K::worker_thread, anyValue(), "", "verify and optimise on a worker thread (same results either way)")
      .nest(&K::verifier, verifierTable())

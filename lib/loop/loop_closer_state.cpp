@@ -4,6 +4,8 @@
 #include "loop/keyframe_codec.hpp"
 #include "loop/loop_closer.hpp"
 
+#include <algorithm>
+
 namespace adit {
 namespace {
 
@@ -142,6 +144,9 @@ bool LoopCloser::restoreState(const std::string& state, const std::vector<std::s
   restored.last_loop_query_ = r.get<std::int32_t>();
   for (int* field : statFields(restored.stats_)) *field = r.get<std::int32_t>();
   if (!r.ok() || !r.atEnd()) return false;
+  // Not a saved field (older checkpoints lack it): a revisit keyframe is the one record without a cloud.
+  restored.stats_.revisit_keyframes = static_cast<int>(std::count_if(
+      restored.keyframes_.begin(), restored.keyframes_.end(), [](const Keyframe& k) { return k.cloud.empty(); }));
   *this = std::move(restored);
   return true;
 }

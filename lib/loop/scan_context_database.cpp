@@ -42,7 +42,12 @@ int ScanContextDatabase::add(const ScanContext& context, std::int64_t utime) {
 }
 
 void ScanContextDatabase::rebuildTree() {
-  const std::size_t dim = static_cast<std::size_t>(contexts_.front().ringKey().size());
+  std::size_t dim = 0;  // of the first real context (a revisit keyframe's is empty)
+  for (const ScanContext& c : contexts_)
+    if (!c.empty()) {
+      dim = static_cast<std::size_t>(c.ringKey().size());
+      break;
+    }
   std::vector<float> keys;
   keys.reserve(contexts_.size() * dim);
   for (const ScanContext& c : contexts_) {

@@ -98,6 +98,7 @@ class LoopCloserNode : public runtime::Node, public WritesProducts, public Write
     setCount("loop_jobs_in_flight", static_cast<std::int64_t>(closer_.jobsInFlight()));
     setCount("loop_wait_ms", static_cast<std::int64_t>(closer_.waitedMs()));
     setCount("keyframes", s.keyframes);
+    setCount("revisit_keyframes", s.revisit_keyframes);
     setCount("loop_candidates", s.candidates);
     setCount("loops_accepted", s.accepted);
     setCount("rejected_fitness", s.rejected_fitness);

@@ -172,6 +172,59 @@ TEST(LoopCloser, AppliesLoopJobsAtAFixedLaterSweepWhateverTheThread) {
   EXPECT_EQ(a.false_loops, 0);
 }
 
+// A robot that keeps driving a mapped roadway: once a loop ties the second lap to the first, its keyframes keep
+// only their graph nodes (loop.revisit_distance), so memory follows the roadway, not the time driven. Loops keep
+// closing against the first lap, the trajectory is corrected as well, the map covers the same roadway, and a
+// checkpoint restores the revisit keyframes as they were.
+TEST(LoopCloser, RevisitedKeyframesKeepOnlyTheirGraphNode) {
+  const BoxWorld world = blockLoop();
+  const auto truth = lapPoses(140 + 70);
+  const auto mapped = drifted(truth, 0.02 * kDeg);
+  LoopCloserConfig keep_all = testConfig();
+  keep_all.revisit_distance = 0;
+  Drive thin{LoopCloser{testConfig()}, 0, {}}, all{LoopCloser{keep_all}, 0, {}};
+  drive(thin, world, truth, mapped);
+  drive(all, world, truth, mapped);
+  printStats(thin.closer.stats());
+  const auto& keyframes = thin.closer.keyframes();
+  std::size_t first_lap_points = 0, later_points = 0;
+  for (std::size_t k = 0; k < keyframes.size(); ++k) (k < 140 ? first_lap_points : later_points) += keyframes[k].cloud.size();
+  const int revisits = thin.closer.stats().revisit_keyframes;
+  std::printf("revisit keyframes %d of %zu; cloud points: first lap %zu, after it %zu\n", revisits, keyframes.size(),
+              first_lap_points, later_points);
+  EXPECT_EQ(all.closer.stats().revisit_keyframes, 0);
+  EXPECT_GE(revisits, 40) << "most of the 70 keyframes after the first lap revisit it";
+  EXPECT_LT(later_points, first_lap_points / 4);
+  for (std::size_t k = 0; k < 140; ++k) EXPECT_FALSE(keyframes[k].cloud.empty()) << "first lap keyframe " << k;
+  // Loops still close (against the first lap), none false, and the correction is as good as keeping everything.
+  EXPECT_GE(thin.closer.stats().accepted, 3);
+  EXPECT_EQ(thin.false_loops, 0);
+  Trajectory uncorrected;
+  for (std::size_t k = 0; k < truth.size(); ++k) uncorrected.push_back({static_cast<std::int64_t>(k) * 1000000, mapped[k]});
+  auto corrected = [&](const LoopCloser& c) {
+    std::vector<Eigen::Isometry3d> out;
+    for (const StampedPose& p : c.correctedTrajectory(uncorrected)) out.push_back(p.pose);
+    return out;
+  };
+  const double ate_thin = ate(corrected(thin.closer), truth), ate_all = ate(corrected(all.closer), truth);
+  std::printf("ATE %.3f m uncorrected, %.3f m keeping every cloud, %.3f m with revisits thinned\n", ate(mapped, truth),
+              ate_all, ate_thin);
+  EXPECT_LE(ate_thin, std::max(1.2 * ate_all, ate_all + 0.05));
+  // The map: the same roadway from fewer clouds (0.5 m voxels occupied by one and not the other: < 10 %).
+  const auto map_thin = thin.closer.correctedMap(0.5), map_all = all.closer.correctedMap(0.5);
+  std::printf("map voxels: %zu with revisits thinned, %zu keeping every cloud\n", map_thin.size(), map_all.size());
+  EXPECT_GT(map_thin.size(), 0.9 * static_cast<double>(map_all.size()));
+  // A checkpoint keeps them: the restored closer has the same state and counts.
+  std::vector<std::string> records;
+  for (int k = 0; k < static_cast<int>(keyframes.size()); ++k) records.push_back(thin.closer.keyframeRecord(k));
+  LoopCloser restored{testConfig()};
+  ASSERT_TRUE(restored.restoreState(thin.closer.saveState(), records));
+  EXPECT_EQ(restored.saveState(), thin.closer.saveState());
+  EXPECT_EQ(restored.stats().revisit_keyframes, revisits);
+  for (int k = 0; k < static_cast<int>(keyframes.size()); ++k)
+    EXPECT_EQ(restored.keyframeRecord(k), records[static_cast<std::size_t>(k)]) << k;
+}
+
 TEST(LoopCloser, RejectsAPeriodicRoadway) {
   // A straight roadway whose equipment repeats exactly every 60 m: a place 60 m back looks identical.
   BoxWorld world;
