@@ -74,3 +74,23 @@ record_series() {
   echo "$dir/record.lcmlog"
   while [ -f "$dir/record.$i.lcmlog" ]; do echo "$dir/record.$i.lcmlog"; i=$((i + 1)); done
 }
+
+# run NAME: one simulated live run of ${LAUNCH_FILE:-launch/sim.launch.yaml} on $WORLD for $DURATION s (the packet
+# loss and reordering tests); facts in $WORK/NAME.facts, APE rmse of ODOM_MAPPED in $WORK/NAME.ape ("none" without one)
+run() {
+  local name=$1 out=$WORK/$1.launch.out
+  start_launch "$out" "${LAUNCH_FILE:-$ROOT/launch/sim.launch.yaml}" --set WORLD="$WORLD" --set DURATION="$DURATION" \
+    --set 'RECORD=^(ODOM_MAPPED|GROUND_TRUTH|STATUS_.*)$' --log-dir "$WORK/$name" --quiet
+  wait_launch
+  echo "$name: adit launch exit code $LAUNCH_RC; $(tail -1 "$out")"
+  mapfile -t series < <(record_series "$(run_dir "$WORK/$name")")
+  mkdir -p "$WORK/$name.tum"
+  "$BIN/fault-facts" --out "$WORK/$name.tum" "${series[@]}" > "$WORK/$name.facts"
+  if "$BIN/adit" eval --gt "$WORK/$name.tum/truth.tum" --est "$WORK/$name.tum/mapped.tum" --align se3 > "$WORK/$name.eval" 2>&1; then
+    awk '/all poses/ { for (i = 1; i <= NF; ++i) if ($i == "rmse") print $(i + 1) }' "$WORK/$name.eval" > "$WORK/$name.ape"
+  else
+    echo "no trajectory: $(tail -1 "$WORK/$name.eval")"
+    echo none > "$WORK/$name.ape"  # fails an APE check
+  fi
+  grep -E '^(outputs|drops|restarted|status_gap_s) |lost_input|time_backwards|seq_reset' "$WORK/$name.facts" | tr '\n' ';'; echo
+}

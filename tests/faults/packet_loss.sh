@@ -19,25 +19,6 @@ if ! command -v nft > /dev/null; then echo "SKIP: nft (Debian package nftables) 
 if tc qdisc add dev lo root netem loss 1% 2>/dev/null; then tc qdisc del dev lo root; netem=available; else netem="not in this kernel"; fi
 echo "tc netem: $netem; packet loss by nftables (numgen random) on incoming multicast packets"
 
-# run NAME: one simulated live run; facts in $WORK/NAME.facts, APE rmse in $WORK/NAME.ape
-run() {
-  local name=$1 out=$WORK/$1.launch.out
-  start_launch "$out" "${LAUNCH_FILE:-$ROOT/launch/sim.launch.yaml}" --set WORLD="$WORLD" --set DURATION="$DURATION" \
-    --set 'RECORD=^(ODOM_MAPPED|GROUND_TRUTH|STATUS_.*)$' --log-dir "$WORK/$name" --quiet
-  wait_launch
-  echo "$name: adit launch exit code $LAUNCH_RC; $(tail -1 "$out")"
-  mapfile -t series < <(record_series "$(run_dir "$WORK/$name")")
-  mkdir -p "$WORK/$name.tum"
-  "$BIN/fault-facts" --out "$WORK/$name.tum" "${series[@]}" > "$WORK/$name.facts"
-  if "$BIN/adit" eval --gt "$WORK/$name.tum/truth.tum" --est "$WORK/$name.tum/mapped.tum" --align se3 > "$WORK/$name.eval" 2>&1; then
-    awk '/all poses/ { for (i = 1; i <= NF; ++i) if ($i == "rmse") print $(i + 1) }' "$WORK/$name.eval" > "$WORK/$name.ape"
-  else
-    echo "no trajectory: $(tail -1 "$WORK/$name.eval")"
-    echo none > "$WORK/$name.ape"  # fails the APE check below
-  fi
-  grep -E '^(outputs|drops|restarted|status_gap_s) |lost_input' "$WORK/$name.facts" | tr '\n' ';'; echo
-}
-
 run clean
 expect "clean run: exit code" "$LAUNCH_RC" == 0
 nft add table ip lossy

@@ -16,25 +16,6 @@ if ! err=$(iptables -A INPUT -d 224.0.0.0/4 -j NFQUEUE --queue-num 7 --queue-byp
 fi
 iptables -D INPUT -d 224.0.0.0/4 -j NFQUEUE --queue-num 7 --queue-bypass
 
-# run NAME: one simulated live run; facts in $WORK/NAME.facts, APE rmse in $WORK/NAME.ape
-run() {
-  local name=$1 out=$WORK/$1.launch.out
-  start_launch "$out" "$ROOT/launch/sim.launch.yaml" --set WORLD="$WORLD" --set DURATION="$DURATION" \
-    --set 'RECORD=^(ODOM_MAPPED|GROUND_TRUTH|STATUS_.*)$' --log-dir "$WORK/$name" --quiet
-  wait_launch
-  echo "$name: adit launch exit code $LAUNCH_RC; $(tail -1 "$out")"
-  mapfile -t series < <(record_series "$(run_dir "$WORK/$name")")
-  mkdir -p "$WORK/$name.tum"
-  "$BIN/fault-facts" --out "$WORK/$name.tum" "${series[@]}" > "$WORK/$name.facts"
-  if "$BIN/adit" eval --gt "$WORK/$name.tum/truth.tum" --est "$WORK/$name.tum/mapped.tum" --align se3 > "$WORK/$name.eval" 2>&1; then
-    awk '/all poses/ { for (i = 1; i <= NF; ++i) if ($i == "rmse") print $(i + 1) }' "$WORK/$name.eval" > "$WORK/$name.ape"
-  else
-    echo "no trajectory: $(tail -1 "$WORK/$name.eval")"
-    echo none > "$WORK/$name.ape"
-  fi
-  grep -E '^(outputs|drops|restarted|status_gap_s) |lost_input|time_backwards|seq_reset' "$WORK/$name.facts" | tr '\n' ';'; echo
-}
-
 run in_order
 expect "in-order run: exit code" "$LAUNCH_RC" == 0
 "$BIN/reorder-queue" --queue 7 --percent "$PERCENT" --max-delay "${MAX_DELAY:-4}" > "$WORK/reorder.out" 2>&1 &
