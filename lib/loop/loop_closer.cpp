@@ -18,6 +18,24 @@ bool isUnsetCovariance(const Matrix6d& c) { return c == Matrix6d::Identity(); }
 
 }  // namespace
 
+Matrix6d odometryDriftCovariance(const LoopCloserConfig& c, double metres) {
+  const double vt = c.odometry_translation_sigma * c.odometry_translation_sigma * metres +
+                    c.odometry_min_translation_sigma * c.odometry_min_translation_sigma;
+  const double vr = c.odometry_rotation_sigma * c.odometry_rotation_sigma * metres +
+                    c.odometry_min_rotation_sigma * c.odometry_min_rotation_sigma;
+  Matrix6d m = Matrix6d::Zero();
+  m.diagonal() << vt, vt, vt, vr, vr, vr;
+  return m;
+}
+
+Matrix6d loopMeasurementCovariance(const LoopCloserConfig& c) {
+  const double vt = c.loop_translation_sigma * c.loop_translation_sigma;
+  const double vr = c.loop_rotation_sigma * c.loop_rotation_sigma;
+  Matrix6d m = Matrix6d::Zero();
+  m.diagonal() << vt, vt, vt, vr, vr, vr;
+  return m;
+}
+
 LoopCloser::LoopCloser(const LoopCloserConfig& config)
     : config_(config), database_(config.candidates, 50) {}
 LoopCloser::~LoopCloser() = default;
@@ -158,12 +176,7 @@ bool LoopCloser::isKeyframe(const Eigen::Isometry3d& pose) const {
 
 Matrix6d LoopCloser::stepCovariance(const Eigen::Isometry3d& new_pose) const {
   const double d = translationNorm(keyframes_.back().uncorrected.inverse() * new_pose);
-  const double var_t = config_.odometry_translation_sigma * config_.odometry_translation_sigma * d +
-                       config_.odometry_min_translation_sigma * config_.odometry_min_translation_sigma;
-  const double var_r = config_.odometry_rotation_sigma * config_.odometry_rotation_sigma * d +
-                       config_.odometry_min_rotation_sigma * config_.odometry_min_rotation_sigma;
-  Matrix6d sigma = Matrix6d::Zero();
-  sigma.diagonal() << var_t, var_t, var_t, var_r, var_r, var_r;
+  Matrix6d sigma = odometryDriftCovariance(config_, d);
   const Eigen::Isometry3d T_new_world = new_pose.inverse();
   for (const auto& [pose, covariance] : sweeps_since_keyframe_) {
     const Matrix6d A = adjoint(T_new_world * pose);

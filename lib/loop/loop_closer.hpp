@@ -99,6 +99,11 @@ struct LoopCloserConfig {
 const ConfigTable<LoopCloserConfig>& loopCloserConfigTable();
 LoopCloserConfig loopCloserConfigFrom(const Config& config);
 
+// Covariance of a relative pose over `metres` of driving under the odometry random walk (odometry_*_sigma).
+Matrix6d odometryDriftCovariance(const LoopCloserConfig& config, double metres);
+// Covariance of one verified loop measurement (loop_*_sigma).
+Matrix6d loopMeasurementCovariance(const LoopCloserConfig& config);
+
 struct LoopCloserStats {
   int sweeps = 0;
   int invalid_sweeps = 0;      // non-finite pose: skipped

@@ -8,14 +8,6 @@
 namespace adit {
 namespace {
 
-Matrix6d loopCovariance(const LoopCloserConfig& config) {
-  const double vt = config.loop_translation_sigma * config.loop_translation_sigma;
-  const double vr = config.loop_rotation_sigma * config.loop_rotation_sigma;
-  Matrix6d c = Matrix6d::Zero();
-  c.diagonal() << vt, vt, vt, vr, vr, vr;
-  return c;
-}
-
 // What a job decides with: its snapshot, the book and the configuration.
 class JobRun {
  public:
@@ -70,7 +62,7 @@ class JobRun {
       ++counts_.rejected_fitness;
       return std::nullopt;
     }
-    const Matrix6d loop_cov = loopCovariance(config_);
+    const Matrix6d loop_cov = loopMeasurementCovariance(config_);
     const double chi2 = loopChi2(v.T_match_query, T_graph, job_.chain.covarianceBetween(m, job_.query), loop_cov);
     if (!(chi2 <= config_.max_odometry_chi2)) {
       ++counts_.rejected_odometry;
@@ -95,7 +87,8 @@ class JobRun {
       return i <= j ? job_.chain.covarianceBetween(i, j) : job_.chain.covarianceBetween(j, i);
     };
     const Matrix6d cov =
-        chain(a.query_index, b.query_index) + chain(a.match_index, b.match_index) + 2.0 * loopCovariance(config_);
+        chain(a.query_index, b.query_index) + chain(a.match_index, b.match_index) +
+        2.0 * loopMeasurementCovariance(config_);
     const PoseGraph& g = job_.graph;
     const Eigen::Isometry3d T_ma_mb = g.pose(a.match_index).inverse() * g.pose(b.match_index);
     const Eigen::Isometry3d T_qa_qb = g.pose(a.query_index).inverse() * g.pose(b.query_index);

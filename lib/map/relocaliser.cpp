@@ -12,28 +12,6 @@
 #include <string>
 
 namespace adit {
-namespace {
-
-// Covariance of a relative pose over `metres` of driving under the loop closer's odometry random walk.
-Matrix6d driftCovariance(const LoopCloserConfig& c, double metres) {
-  const double vt = c.odometry_translation_sigma * c.odometry_translation_sigma * metres +
-                    c.odometry_min_translation_sigma * c.odometry_min_translation_sigma;
-  const double vr = c.odometry_rotation_sigma * c.odometry_rotation_sigma * metres +
-                    c.odometry_min_rotation_sigma * c.odometry_min_rotation_sigma;
-  Matrix6d m = Matrix6d::Zero();
-  m.diagonal() << vt, vt, vt, vr, vr, vr;
-  return m;
-}
-
-Matrix6d fitCovariance(const LoopCloserConfig& c) {
-  const double vt = c.loop_translation_sigma * c.loop_translation_sigma;
-  const double vr = c.loop_rotation_sigma * c.loop_rotation_sigma;
-  Matrix6d m = Matrix6d::Zero();
-  m.diagonal() << vt, vt, vt, vr, vr, vr;
-  return m;
-}
-
-}  // namespace
 
 const ConfigTable<RelocaliserConfig>& relocaliserConfigTable() {
   using R = RelocaliserConfig;
@@ -285,8 +263,8 @@ bool Relocaliser::consistent(const Fix& a, const Fix& b) const {
                                     bundle_.keyframes[static_cast<std::size_t>(b.match)].pose;
   const Eigen::Isometry3d T_qa_qb = a.session.inverse() * b.session;
   const double driven = std::abs(b.travelled - a.travelled);
-  const Matrix6d cov = driftCovariance(loop_, driven) + driftCovariance(loop_, translationNorm(T_ma_mb)) +
-                       2.0 * fitCovariance(loop_);
+  const Matrix6d cov = odometryDriftCovariance(loop_, driven) +
+                       odometryDriftCovariance(loop_, translationNorm(T_ma_mb)) + 2.0 * loopMeasurementCovariance(loop_);
   return pairChi2(a.T_match_query, b.T_match_query, T_ma_mb, T_qa_qb, cov) <= loop_.max_pair_chi2;
 }
 
