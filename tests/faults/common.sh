@@ -94,3 +94,19 @@ run() {
   fi
   grep -E '^(outputs|drops|restarted|status_gap_s) |lost_input|time_backwards|seq_reset' "$WORK/$name.facts" | tr '\n' ';'; echo
 }
+
+# expect_run_survived NAME BASELINE LABEL: the checks every network-fault run shares against its baseline run:
+# no stage restarted or went silent for 5 s, sweeps still arrived, and the APE of NAME is within 20 % (or 2 cm,
+# run-to-run noise at real time) of BASELINE's. Sets ARRIVED (sweeps at the feature stage) and the two APEs.
+expect_run_survived() {
+  local name=$1 baseline=$2 label=$3 p
+  BASELINE_APE=$(cat "$WORK/$baseline.ape") RUN_APE=$(cat "$WORK/$name.ape")
+  ARRIVED=$(fact "$WORK/$name.facts" outputs STATUS_FEATURE)
+  for p in FEATURE ODOMETRY MAPPER LOOP_CLOSER; do
+    expect "STATUS_$p restarts" "$(fact "$WORK/$name.facts" restarted STATUS_$p)" == 0
+    expect "longest silence of STATUS_$p (s)" "$(fact "$WORK/$name.facts" status_gap_s STATUS_$p)" "<" 5
+  done
+  expect "sweeps that reached the feature stage (of $((DURATION * 10)))" "$ARRIVED" ">" 0
+  expect "APE rmse with $label (m; $baseline $BASELINE_APE m)" "$RUN_APE" "<=" \
+    "$(awk -v a="$BASELINE_APE" 'BEGIN { print (a * 1.2 > a + 0.02) ? a * 1.2 : a + 0.02 }')"
+}
