@@ -2,13 +2,21 @@
 
 #include <cmath>
 #include <stdexcept>
+#include <string>
 
 namespace adit::sim {
 namespace {
 
 WorldConfig resolveWorld(const SimConfig& c) {
-  if (c.roadway) return *c.roadway;
-  return worldConfigFor(c.world, c.seed);
+  if (!c.roadway) return worldConfigFor(c.world, c.seed);
+  // simConfigFrom resolves the geometry from sim.world and sim.seed; a world or seed changed on the struct
+  // afterwards would silently simulate the geometry of the old one. Set them in the configuration instead.
+  if (c.roadway->name != c.world || c.roadway->seed != c.seed)
+    throw std::invalid_argument("sim: world '" + c.world + "' seed " + std::to_string(c.seed) +
+                                " does not match the resolved geometry of '" + c.roadway->name + "' seed " +
+                                std::to_string(c.roadway->seed) +
+                                " (set sim.world / sim.seed before simConfigFrom, or reset SimConfig::roadway)");
+  return *c.roadway;
 }
 
 }  // namespace
@@ -26,6 +34,12 @@ SimConfig simConfigFrom(const adit::Config& cfg) {
   c.lidar.dust = cfg.get("sim.dust", c.lidar.dust);
   c.imu = imuConfigFrom(cfg);
   return c;
+}
+
+SimConfig simConfigFrom(adit::Config cfg, const std::string& world, std::uint64_t seed) {
+  cfg.set("sim.world", world);
+  cfg.set("sim.seed", std::to_string(seed));
+  return simConfigFrom(cfg);
 }
 
 Simulator::Simulator(const SimConfig& config)

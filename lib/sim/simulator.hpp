@@ -40,7 +40,9 @@ struct SimConfig {
   double duration_s = 60.0;            // simulated seconds (sweeps and IMU samples up to this time)
   std::uint64_t seed = 1;              // drives the world, the motion, and all noise
   std::int64_t start_utime = 1700000000000000;  // utime of time 0 (2023-11-14), any value works
-  std::optional<WorldConfig> roadway;  // world geometry; unset = worldConfigFor(world, seed)
+  // World geometry; unset = worldConfigFor(world, seed). When set, its name and seed must equal world and seed
+  // (the Simulator throws otherwise): change sim.world / sim.seed in the configuration, not on this struct.
+  std::optional<WorldConfig> roadway;
   MotionConfig motion;
   LidarNoiseConfig lidar;
   ImuConfig imu;
@@ -53,6 +55,8 @@ struct SimConfig {
 // sim.imu.* (ImuConfig); every default as documented on the structs (launch/worlds/roadway-loop.yaml lists them
 // all). Throws std::invalid_argument for an unknown world, std::runtime_error for a value that does not parse.
 SimConfig simConfigFrom(const adit::Config& c);
+// The same with sim.world and sim.seed replaced before the world's geometry is resolved.
+SimConfig simConfigFrom(adit::Config c, const std::string& world, std::uint64_t seed);
 
 struct SimEvent {
   enum class Kind { Scan, Imu };

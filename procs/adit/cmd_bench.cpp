@@ -182,8 +182,7 @@ void registerPipelineBench(CLI::App& bench) {
     std::unique_ptr<adit::sources::SimSource> sim;
     std::string input = a->log;
     if (a->log.empty()) {
-      adit::sim::SimConfig s = adit::sim::simConfigFrom(options.config);
-      s.world = a->world;
+      adit::sim::SimConfig s = adit::sim::simConfigFrom(options.config, a->world, options.config.get<std::uint64_t>("sim.seed", 1));
       s.sensor = a->sensor;
       s.duration_s = a->duration_s;
       sim = std::make_unique<adit::sources::SimSource>(s, adit::sources::SimChannels{});

@@ -51,11 +51,9 @@ void registerDemoCommand(CLI::App& app) {
     const fs::path out = a->out_dir.empty() ? root / "logs" / "demo" : fs::path(a->out_dir);
     fs::create_directories(out);
 
-    adit::sim::SimConfig sim = adit::sim::simConfigFrom(config);
-    sim.world = a->world;
+    adit::sim::SimConfig sim = adit::sim::simConfigFrom(config, a->world, static_cast<std::uint64_t>(a->seed));
     sim.sensor = a->sensor;
     sim.duration_s = a->duration_s;
-    sim.seed = static_cast<std::uint64_t>(a->seed);
     adit::sources::SimSource source(sim, {});
     fmt::print("demo: {} ({:.0f} m route), {}, {:.0f} s simulated, seed {}; pipeline config: {}\n", sim.world,
                source.simulator().lapLength(), sim.sensor, sim.duration_s, sim.seed,

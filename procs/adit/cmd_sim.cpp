@@ -110,11 +110,14 @@ void registerSimCommand(CLI::App& app) {
   cmd->add_option("--stall-imu", a->stall_imu, "Fault test: publish no IMU from START for SECONDS (START:SECONDS)");
   cmd->callback([a] {
     if (a->live == !a->output.empty()) throw CLI::ValidationError("adit sim", "give either -o LOG or --live");
-    adit::sim::SimConfig config = adit::sim::simConfigFrom(adit::runtime::loadConfig(a->configs));
-    if (!a->world.empty()) config.world = a->world;
-    if (!a->sensor.empty()) config.sensor = a->sensor;
+    // The flags go into the configuration before it is resolved: the world's geometry depends on the world's
+    // name and the seed (a --world set afterwards used to build the file's or the default world).
+    adit::Config file = adit::runtime::loadConfig(a->configs);
+    if (!a->world.empty()) file.set("sim.world", a->world);
+    if (!a->sensor.empty()) file.set("sim.sensor", a->sensor);
+    if (a->seed >= 0) file.set("sim.seed", std::to_string(a->seed));
+    adit::sim::SimConfig config = adit::sim::simConfigFrom(file);
     if (a->duration_s > 0) config.duration_s = a->duration_s;
-    if (a->seed >= 0) config.seed = static_cast<std::uint64_t>(a->seed);
     if (a->start_speed >= 0) config.motion.start_speed = a->start_speed;
     if (a->start_distance >= 0) config.motion.start_distance = a->start_distance;
     if (a->reverse) config.motion.reverse = true;

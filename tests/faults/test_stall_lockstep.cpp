@@ -18,8 +18,7 @@ namespace fs = std::filesystem;
 TEST(SensorStall, MappedTrajectoryDoesNotJumpAcrossALidarGap) {
   const fs::path launch = fs::path(ADIT_SOURCE_DIR) / "launch";
   const adit::Config config = adit::runtime::loadConfig({(launch / "config" / "pipeline.yaml").string()});
-  adit::sim::SimConfig sim = adit::sim::simConfigFrom(config);
-  sim.world = "roadway-straight";
+  adit::sim::SimConfig sim = adit::sim::simConfigFrom(config, "roadway-straight", 1);
   sim.duration_s = 35;
   adit::sources::SimStalls stalls;
   stalls.lidar = {12.0, 10.0};

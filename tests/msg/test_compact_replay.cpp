@@ -80,11 +80,9 @@ ReplayRun replay(SweepFormatSource::Form form, const std::string& tag, double se
   const fs::path launch = fs::path(ADIT_SOURCE_DIR) / "launch";
   const Config config = runtime::loadConfig(
       {(launch / "config" / "pipeline.yaml").string(), (launch / "sensors" / "sim.yaml").string()});
-  sim::SimConfig sim = sim::simConfigFrom(config);
-  sim.world = "roadway-loop";
+  sim::SimConfig sim = sim::simConfigFrom(config, "roadway-loop", 4);
   sim.sensor = "vlp16";
   sim.duration_s = seconds;
-  sim.seed = 4;
   SweepFormatSource source(sim, form);
   pipeline::ReplayOptions options;
   options.source = &source;

@@ -45,11 +45,9 @@ adit::pose_graph_t poseGraph(const std::vector<adit::odometry_t>& keyframes, std
 }  // namespace
 
 RecordedRun recordRun(const Config& config, double seconds, int seed) {
-  sim::SimConfig sim = sim::simConfigFrom(config);
-  sim.world = "roadway-loop";
+  sim::SimConfig sim = sim::simConfigFrom(config, "roadway-loop", static_cast<std::uint64_t>(seed));
   sim.sensor = "vlp16";
   sim.duration_s = seconds;
-  sim.seed = seed;
   sources::SimChannels channels;
   channels.ground_truth = "";
   sources::SimSource source(sim, channels);

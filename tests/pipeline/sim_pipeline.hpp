@@ -44,10 +44,8 @@ inline SimPipelineRun runSimPipeline(const std::string& world, double duration_s
   const fs::path launch = fs::path(ADIT_SOURCE_DIR) / "launch";
   const Config config = runtime::loadConfig(
       {(launch / "config" / "pipeline.yaml").string(), (launch / "sensors" / "sim.yaml").string()});
-  sim::SimConfig sim = sim::simConfigFrom(config);
-  sim.world = world;
+  sim::SimConfig sim = sim::simConfigFrom(config, world, seed);
   sim.duration_s = duration_s;
-  sim.seed = seed;
   if (setup.adjust) setup.adjust(sim);
   sources::SimChannels channels;
   if (!setup.imu) channels.imu.clear();

@@ -33,8 +33,7 @@ Drive drive(double duration_s, double start_distance, const std::string& name, c
   const fs::path launch = fs::path(ADIT_SOURCE_DIR) / "launch";
   const Config config = runtime::loadConfig(
       {(launch / "config" / "pipeline.yaml").string(), (launch / "sensors" / "sim.yaml").string()});
-  sim::SimConfig sim = sim::simConfigFrom(config);
-  sim.world = "roadway-loop";
+  sim::SimConfig sim = sim::simConfigFrom(config, "roadway-loop", 1);
   sim.duration_s = duration_s;
   sim.motion.start_distance = start_distance;
   sources::SimSource source(sim, sources::SimChannels{});

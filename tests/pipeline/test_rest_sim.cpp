@@ -48,7 +48,6 @@ void expectAtRest(const std::string& world, bool noisy) {
     c.motion.stationary = true;
     c.motion.idle_vibration = noisy ? 0.5 : 0.0;  // 0.15 deg RMS pitch/roll, 2 mm RMS bounce
     c.lidar.noiseless = c.imu.noiseless = !noisy;
-    c.roadway = sim::worldConfigFor(c.world, c.seed);  // simConfigFrom fixed the default world's geometry
   };
   const auto run = test::runSimPipeline(world, kRestSeconds, 2, setup);
   ASSERT_EQ(run.ground_truth.size(), static_cast<std::size_t>(kRestSeconds * 10));
