@@ -70,13 +70,11 @@ ReplayRun replay(std::vector<runtime::OutgoingMessage> messages, const Trajector
   return run;
 }
 
-// The run both recordings are made of: 20 s of roadway-loop with a VLP-16 (200 sweeps, seed 4).
-sim::SimConfig twentySecondsOfRoadwayLoop() {
-  sim::SimConfig sim = sim::simConfigFrom(pipelineConfig());
-  sim.world = "roadway-loop";
+// The run the recordings are made of: 20 s of roadway-loop with a VLP-16 (200 sweeps).
+sim::SimConfig twentySecondsOfRoadwayLoop(std::uint64_t seed = 4) {
+  sim::SimConfig sim = sim::simConfigFrom(pipelineConfig(), "roadway-loop", seed);
   sim.sensor = "vlp16";
   sim.duration_s = 20.0;
-  sim.seed = 4;
   return sim;
 }
 
@@ -88,8 +86,12 @@ std::vector<runtime::OutgoingMessage> drain(runtime::MessageSource& source) {
   return messages;
 }
 
-TEST(PcapReplay, SameAccuracyAsTheSimulatorsLog) {
-  sources::SimSource source(twentySecondsOfRoadwayLoop(), sources::SimChannels{});
+struct PcapVsLog {
+  ReplayRun log, pcap;
+};
+
+PcapVsLog replayCaptureAndLog(std::uint64_t seed) {
+  sources::SimSource source(twentySecondsOfRoadwayLoop(seed), sources::SimChannels{});
   const std::string pcap = (fs::temp_directory_path() / ("adit_pcap_replay_" + std::to_string(::getpid()) + ".pcap")).string();
   std::vector<runtime::OutgoingMessage> logged;
   std::int64_t packets = 0;
@@ -118,18 +120,30 @@ TEST(PcapReplay, SameAccuracyAsTheSimulatorsLog) {
   const auto first_sweep = std::find_if(logged.begin(), logged.end(),
                                         [](const runtime::OutgoingMessage& m) { return m.channel == "LIDAR_POINTS"; });
   if (first_sweep != logged.end()) logged.erase(first_sweep);
-  const ReplayRun log_run = replay(logged, source.groundTruth(), "log");
-  const ReplayRun pcap_run = replay(from_pcap, source.groundTruth(), "pcap");
-  std::printf("%lld packets; sweeps: log %lld, pcap %lld; APE rmse: log %.4f m, pcap %.4f m (%+.1f %%)\n",
-              static_cast<long long>(packets), static_cast<long long>(log_run.sweeps),
-              static_cast<long long>(pcap_run.sweeps), log_run.ape_rmse_m, pcap_run.ape_rmse_m,
-              100.0 * (pcap_run.ape_rmse_m / log_run.ape_rmse_m - 1.0));
+  PcapVsLog runs{replay(logged, source.groundTruth(), "log"), replay(from_pcap, source.groundTruth(), "pcap")};
+  std::printf("seed %llu: %lld packets; sweeps: log %lld, pcap %lld; APE rmse: log %.4f m, pcap %.4f m (%+.1f %%)\n",
+              static_cast<unsigned long long>(seed), static_cast<long long>(packets),
+              static_cast<long long>(runs.log.sweeps), static_cast<long long>(runs.pcap.sweeps), runs.log.ape_rmse_m,
+              runs.pcap.ape_rmse_m, 100.0 * (runs.pcap.ape_rmse_m / runs.log.ape_rmse_m - 1.0));
   EXPECT_EQ(health.errors, 0);
   // Every revolution after the first is there, the last flagged partial.
-  EXPECT_EQ(pcap_run.sweeps, log_run.sweeps);
-  // The capture's 2 mm range steps and per-firing times give the pipeline slightly different points: the
-  // APE stays within 5 % of the log's either way (measured -4.9 %).
-  EXPECT_LE(std::abs(pcap_run.ape_rmse_m - log_run.ape_rmse_m), 0.05 * log_run.ape_rmse_m);
+  EXPECT_EQ(runs.pcap.sweeps, runs.log.sweeps);
+  return runs;
+}
+
+TEST(PcapReplay, SameAccuracyAsTheSimulatorsLog) {
+  // The capture's 2 mm range steps and per-firing times give the pipeline slightly different points, and one
+  // 20 s run's APE (~1 cm) moves by several per cent with any such change (-4.9 % and +7.8 % on two worlds).
+  // So the claim is made over three drives: the mean APE stays within 5 % of the log's either way.
+  double log_sum = 0, pcap_sum = 0;
+  for (const std::uint64_t seed : {4, 5, 6}) {
+    const PcapVsLog runs = replayCaptureAndLog(seed);
+    log_sum += runs.log.ape_rmse_m;
+    pcap_sum += runs.pcap.ape_rmse_m;
+  }
+  std::printf("mean APE rmse over 3 drives: log %.4f m, pcap %.4f m (%+.1f %%)\n", log_sum / 3, pcap_sum / 3,
+              100.0 * (pcap_sum / log_sum - 1.0));
+  EXPECT_LE(std::abs(pcap_sum - log_sum), 0.05 * log_sum);
 }
 
 TEST(BagReplay, SameAccuracyAsTheSimulatorsLog) {
