@@ -25,15 +25,15 @@ ConfigTable<LoopVerifierConfig> verifierTable() {
      .add("fine_correspondence_distance", &I::fine_correspondence_distance, above(0), "m", "correspondence gate of the fine phase")
      .add("inlier_residual", &I::inlier_residual, above(0), "m", "point-to-plane residual below which a point is an inlier")
      .add("normal_neighbors", &I::normal_neighbors, between(3, 1000), "points", "neighbours per target normal")
-     .add("max_surface_variation", &I::max_surface_variation, between(0, 1), "", "largest surface variation of a planar target point")
-     .add("characteristic_length", &I::characteristic_length, above(0), "m", "puts rotations and translations on one scale for the eigenvalue test");
+     .add("max_surface_variation", &I::max_surface_variation, between(0, 1), "", "largest surface variation of a planar target point");
   ConfigTable<V> t("loop.verifier");
   t.add("submap_neighbors", &V::submap_neighbors, between(0, 1000), "keyframes", "keyframes each side of the candidate merged into its submap")
    .add("submap_voxel", &V::submap_voxel, between(0.01, 100), "m", "voxel of the submap (ICP target)")
    .add("query_voxel", &V::query_voxel, between(0.01, 100), "m", "voxel of the query cloud (ICP source)")
    .add("max_rms", &V::max_rms, above(0), "m", "largest RMS point-to-plane residual of an accepted fit")
    .add("min_inlier_ratio", &V::min_inlier_ratio, between(0, 1), "", "smallest share of query points that are inliers")
-   .add("min_eigenvalue_ratio", &V::min_eigenvalue_ratio, between(0, 1), "", "smallest / largest ICP Hessian eigenvalue: below, a direction is unconstrained")
+   .add("min_eigenvalue_ratio", &V::min_eigenvalue_ratio, between(0, 1), "", "smallest / largest eigenvalue of the fit's translation information: below, a direction is unconstrained")
+   .add("max_rotation_sigma", &V::max_rotation_sigma, above(0), "rad", "standard deviation of the least constrained rotation of a fit at its residual: above, unconstrained")
    .nest(&V::icp, icp);
   return t;
 }

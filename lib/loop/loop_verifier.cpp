@@ -48,7 +48,8 @@ LoopVerification verifyLoopAgainst(const PlaneTarget& target, const std::vector<
     if (fitsTightly(r, config)) break;
   }
   if (!fitsTightly(out.icp, config)) return out;
-  if (out.icp.eigenvalue_ratio < config.min_eigenvalue_ratio)
+  const FitObservability& pinned = out.icp.observability;
+  if (pinned.weakestTranslationRatio() < config.min_eigenvalue_ratio || pinned.rotation_sigma_rad > config.max_rotation_sigma)
     out.verdict = LoopVerdict::kDegenerate;
   else if (out.icp.converged)
     out.verdict = LoopVerdict::kAccepted;

@@ -20,9 +20,11 @@ struct LoopVerifierConfig {
   // A correct revisit in a rough-walled roadway fits to a few cm with most points; an aliased place fits worse.
   double max_rms = 0.06;
   double min_inlier_ratio = 0.6;
-  // Smallest / largest eigenvalue of the scaled ICP Hessian: below this one direction (typically along a
-  // featureless straight roadway) is not constrained and the loop is rejected.
+  // Smallest / largest eigenvalue of the fit's translation information (rotation marginalised out): below this
+  // one direction (typically along a featureless straight roadway) is not constrained and the loop is rejected.
   double min_eigenvalue_ratio = 0.01;
+  // Standard deviation (rad) of the least constrained rotation at the fit's residual: above it, rejected too.
+  double max_rotation_sigma = 0.005;
 };
 
 enum class LoopVerdict {

@@ -137,12 +137,8 @@ IcpResult alignPointToPlane(const PlaneTarget& target, const std::vector<Eigen::
   result.inlier_ratio = static_cast<double>(lin.inliers) / static_cast<double>(src.size());
   result.rms = lin.inliers > 0 ? std::sqrt(lin.inlier_sq_sum / lin.inliers) : 0.0;
   result.hessian = lin.H_inliers;
-  Matrix6d S = Matrix6d::Identity();
-  S.bottomRightCorner<3, 3>() /= std::max(1e-3, config.characteristic_length);
-  const Eigen::SelfAdjointEigenSolver<Matrix6d> eig(S * lin.H_inliers * S);
-  result.eigenvalues = eig.eigenvalues();
-  const double largest = result.eigenvalues[5];
-  result.eigenvalue_ratio = largest > 0.0 ? std::max(0.0, result.eigenvalues[0]) / largest : 0.0;
+  // Below ~1 cm the residual is the surfaces' own roughness, not the fit's quality.
+  result.observability = analyseFit(lin.H_inliers, std::max(result.rms, 0.01));
   return result;
 }
 

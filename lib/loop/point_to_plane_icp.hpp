@@ -3,6 +3,7 @@
 #pragma once
 
 #include "core/types.hpp"
+#include "loop/fit_observability.hpp"
 
 #include <memory>
 #include <vector>
@@ -25,9 +26,6 @@ struct IcpConfig {
   // Stop a phase when the update is below these (m, rad).
   double converged_translation = 1e-4;
   double converged_rotation = 1e-5;
-  // Length (m) that puts rotations and translations on one scale for the eigenvalue test: a rotation of
-  // theta moves points at this distance by theta * length (the middle of a roadway keyframe cloud).
-  double characteristic_length = 10.0;
 };
 
 struct IcpResult {
@@ -38,8 +36,7 @@ struct IcpResult {
   double rms = 0.0;          // RMS point-to-plane residual of the inliers (m)
   double inlier_ratio = 0.0; // inliers / valid source points
   Matrix6d hessian = Matrix6d::Zero();  // sum of J^T J over inliers, tangent order (t, r), left perturbation
-  Eigen::Matrix<double, 6, 1> eigenvalues = Eigen::Matrix<double, 6, 1>::Zero();  // of the scaled Hessian, ascending
-  double eigenvalue_ratio = 0.0;  // smallest / largest scaled eigenvalue: ~0 when a direction is unconstrained
+  FitObservability observability;  // which directions the fit pins (from hessian, at rms floored to 1 cm)
 };
 
 // A target cloud with a KD-tree and normals, built once and aligned against many times.

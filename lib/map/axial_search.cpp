@@ -1,8 +1,5 @@
 #include "map/axial_search.hpp"
 
-#include <Eigen/Eigenvalues>
-#include <Eigen/LU>
-
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -10,26 +7,13 @@
 namespace adit {
 namespace {
 
-// The translation along which the fit is weakest (left perturbation: in the target frame), from the Hessian's
-// translation block with the rotation marginalised out; zero when a second translation is weak too (a
-// relative test) or a rotation is (its standard deviation at the fit's residual). The loop closer's scaled
-// eigenvalue test is not used here: it counts a roll about the roadway's axis as weak because its points are a
-// few metres, not its characteristic 10 m, from the axis, though floor and walls pin it.
-Eigen::Vector3d weakTranslation(const IcpResult& fit, const LoopVerifierConfig& verifier, const AxialSearchConfig& config) {
-  const Matrix6d& H = fit.hessian;
-  const Eigen::Matrix3d Htt = H.topLeftCorner<3, 3>(), Hrr = H.bottomRightCorner<3, 3>(), Htr = H.topRightCorner<3, 3>();
-  // The weak translation may be wholly unconstrained (nothing but repeats in view): a tiny ridge keeps the
-  // rotation's marginal finite there.
-  const Eigen::FullPivLU<Eigen::Matrix3d> rr(Hrr), tt(Htt + 1e-6 * Htt.trace() * Eigen::Matrix3d::Identity());
-  if (!rr.isInvertible() || !tt.isInvertible()) return Eigen::Vector3d::Zero();
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> trans(Htt - Htr * rr.solve(Htr.transpose()));
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> rot(Hrr - Htr.transpose() * tt.solve(Htr));
-  const double largest = trans.eigenvalues()[2];
-  if (largest <= 0.0 || trans.eigenvalues()[1] / largest < verifier.min_eigenvalue_ratio) return Eigen::Vector3d::Zero();
-  const double sigma = std::max(fit.rms, 0.01);
-  if (rot.eigenvalues()[0] <= 0.0 || sigma / std::sqrt(rot.eigenvalues()[0]) > config.max_rotation_sigma)
+// The translation along which the fit is weakest (left perturbation: in the target frame); zero when a second
+// translation is weak too or a rotation is (FitObservability, with the loop verifier's thresholds).
+Eigen::Vector3d weakTranslation(const IcpResult& fit, const LoopVerifierConfig& verifier) {
+  const FitObservability& pinned = fit.observability;
+  if (pinned.middleTranslationRatio() < verifier.min_eigenvalue_ratio || pinned.rotation_sigma_rad > verifier.max_rotation_sigma)
     return Eigen::Vector3d::Zero();
-  return trans.eigenvectors().col(0).normalized();
+  return pinned.weakestTranslation().normalized();
 }
 
 struct Place {
@@ -95,8 +79,7 @@ const ConfigTable<AxialSearchConfig>& axialSearchConfigTable() {
      .add("refined", &A::refined, between(1, 100), "", "best distinct places refined by the full ICP")
      .add("separation", &A::separation, above(0), "m", "fits farther apart along the line are different places")
      .add("min_inlier_ratio", &A::min_inlier_ratio, between(0, 1), "", "the best fit's share of inliers")
-     .add("margin", &A::margin, between(0, 1), "", "inlier ratio the best fit must have over the best fit elsewhere on the line")
-     .add("max_rotation_sigma", &A::max_rotation_sigma, above(0), "rad", "standard deviation of the least constrained rotation of a fit at its residual");
+     .add("margin", &A::margin, between(0, 1), "", "inlier ratio the best fit must have over the best fit elsewhere on the line");
     return t;
   }();
   return table;
@@ -106,7 +89,7 @@ AxialSearchResult searchWeakDirection(const PlaneTarget& target, const std::vect
                                       const IcpResult& fit, const LoopVerifierConfig& verifier,
                                       const AxialSearchConfig& config) {
   AxialSearchResult out;
-  const Eigen::Vector3d axis = weakTranslation(fit, verifier, config);
+  const Eigen::Vector3d axis = weakTranslation(fit, verifier);
   if (axis.isZero()) {
     out.refusal = "weak";
     return out;
@@ -125,7 +108,7 @@ AxialSearchResult searchWeakDirection(const PlaneTarget& target, const std::vect
       if (std::abs(p.along - best.along) >= config.separation) out.runner_up = std::max(out.runner_up, p.icp.inlier_ratio);
   if (!fitsTightly(best.icp, verifier) || !best.icp.converged || best.icp.inlier_ratio < config.min_inlier_ratio)
     out.refusal = "loose";
-  else if (weakTranslation(best.icp, verifier, config).isZero())
+  else if (weakTranslation(best.icp, verifier).isZero())
     out.refusal = "weak";
   else if (best.icp.inlier_ratio - out.runner_up < config.margin)
     out.refusal = "ambiguous";

@@ -22,9 +22,8 @@ struct AxialSearchConfig {
   double separation = 0.6;    // m along the line: fits farther apart are different places
   double min_inlier_ratio = 0.85;  // the best fit's share of inliers
   double margin = 0.08;       // over the best fit at another place
-  // Standard deviation (rad) of the least constrained rotation of a fit, at its residual: above it the fit is
-  // refused (the search resolves one translation, not a rotation).
-  double max_rotation_sigma = 0.005;
+  // A fit whose rotation is weak (loop.verifier.max_rotation_sigma) is refused: the search resolves one
+  // translation, not a rotation.
 };
 
 const ConfigTable<AxialSearchConfig>& axialSearchConfigTable();
