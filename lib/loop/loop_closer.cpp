@@ -5,6 +5,8 @@
 #include "core/geometry.hpp"
 #include "loop/voxel_filter.hpp"
 
+#include <Eigen/Eigenvalues>
+
 #include <algorithm>
 #include <cmath>
 
@@ -34,6 +36,30 @@ Matrix6d loopMeasurementCovariance(const LoopCloserConfig& c) {
   Matrix6d m = Matrix6d::Zero();
   m.diagonal() << vt, vt, vt, vr, vr, vr;
   return m;
+}
+
+Matrix6d partialLoopCovariance(const LoopCloserConfig& c, const Eigen::Vector3d& axis) {
+  Matrix6d m = loopMeasurementCovariance(c);
+  m.topLeftCorner<3, 3>() += c.partial_loop_axis_sigma * c.partial_loop_axis_sigma * axis * axis.transpose();
+  return m;
+}
+
+namespace {
+constexpr double kMeasuredInformation = 1.0;  // 1 / (1 m)^2
+}
+
+bool isPartialLoop(const LoopConstraint& loop) {
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(loop.information.topLeftCorner<3, 3>());
+  return eig.eigenvalues()[0] < kMeasuredInformation;
+}
+
+Eigen::Vector3d measuredPart(const LoopConstraint& loop, const Eigen::Vector3d& translation) {
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(loop.information.topLeftCorner<3, 3>());
+  Eigen::Vector3d out = Eigen::Vector3d::Zero();
+  for (int i = 0; i < 3; ++i)
+    if (eig.eigenvalues()[i] >= kMeasuredInformation)
+      out += eig.eigenvectors().col(i) * eig.eigenvectors().col(i).dot(translation);
+  return out;
 }
 
 LoopCloser::LoopCloser(const LoopCloserConfig& config)
@@ -140,6 +166,7 @@ void LoopCloser::applyDue(std::int64_t utime, bool all, Result& result) {
     stats_.rejected_odometry += c.rejected_odometry;
     stats_.rejected_pairwise += c.rejected_pairwise;
     stats_.accepted += c.accepted;
+    stats_.partial_loops += c.partial_loops;
     stats_.optimizations += c.optimizations;
     stats_.pending = c.pending;
     accepted_ = std::move(o.book.accepted);

@@ -4,7 +4,8 @@
 // Per sweep: process(mapped pose, deskewed cloud). Every ~1 m / ~10 deg a keyframe is added with its
 // downsampled cloud and Scan Context; a candidate becomes a loop only if
 //   1. its Scan Context distance is below the threshold (database query excludes recent keyframes),
-//   2. ICP of the query keyframe against the candidate's submap fits tightly and constrains all 6 directions,
+//   2. ICP of the query keyframe against the candidate's submap fits tightly and constrains all 6 directions
+//      (or all but one translation: a partial loop, which constrains only what it observes),
 //   3. the implied correction is plausible given the odometry uncertainty accumulated since the candidate
 //      (Mahalanobis gate), and
 //   4. it agrees with an accepted loop nearby, or with min_consistent_loops - 1 other pending loops.
@@ -69,6 +70,17 @@ struct LoopCloserConfig {
 
   // --- verification ---
   LoopVerifierConfig verifier;
+  // A fit that pins every direction but one translation (the axis of a smooth straight roadway) joins the graph
+  // as a partial loop: its covariance along that axis is partial_loop_axis_sigma, so it corrects the cross-
+  // section, the height and the heading where a full loop would be refused, and leaves the position along the
+  // roadway to the odometry.
+  // Along the free axis the loop takes the graph's relative pose (what ICP slid to there is arbitrary, and a
+  // slide of tens of metres times the axis' small error would leak into the cross-section), and the graph must
+  // put the two keyframes within partial_loop_max_axis_offset of each other along it: the roadway is taken as
+  // straight over that span, not over the whole featureless stretch.
+  bool partial_loops = true;
+  double partial_loop_axis_sigma = 100.0;  // m
+  double partial_loop_max_axis_offset = 10.0;  // m
 
   // --- consistency ---
   // Odometry step noise added to each keyframe step (random-walk model, per sqrt of metres travelled) on top of
@@ -103,6 +115,12 @@ LoopCloserConfig loopCloserConfigFrom(const Config& config);
 Matrix6d odometryDriftCovariance(const LoopCloserConfig& config, double metres);
 // Covariance of one verified loop measurement (loop_*_sigma).
 Matrix6d loopMeasurementCovariance(const LoopCloserConfig& config);
+// The same for a partial loop, free along `axis` (unit, the query keyframe's frame).
+Matrix6d partialLoopCovariance(const LoopCloserConfig& config, const Eigen::Vector3d& axis);
+// A loop whose information leaves a translation with a standard deviation above 1 m: a partial loop.
+bool isPartialLoop(const LoopConstraint& loop);
+// The part of `translation` (the query keyframe's frame) that the loop measures: without its free axis.
+Eigen::Vector3d measuredPart(const LoopConstraint& loop, const Eigen::Vector3d& translation);
 
 struct LoopCloserStats {
   int sweeps = 0;
@@ -116,6 +134,7 @@ struct LoopCloserStats {
   int rejected_pairwise = 0;   // inconsistent with an accepted loop nearby
   int pending = 0;             // verified loops waiting for a consistent partner
   int accepted = 0;
+  int partial_loops = 0;       // accepted loops that leave one translation free (partial_loops)
   int optimizations = 0;
   int revisit_keyframes = 0;   // keyframes that kept only their graph node (revisit_distance)
 };

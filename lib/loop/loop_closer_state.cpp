@@ -147,6 +147,8 @@ bool LoopCloser::restoreState(const std::string& state, const std::vector<std::s
   // Not a saved field (older checkpoints lack it): a revisit keyframe is the one record without a cloud.
   restored.stats_.revisit_keyframes = static_cast<int>(std::count_if(
       restored.keyframes_.begin(), restored.keyframes_.end(), [](const Keyframe& k) { return k.cloud.empty(); }));
+  restored.stats_.partial_loops =
+      static_cast<int>(std::count_if(restored.accepted_.begin(), restored.accepted_.end(), isPartialLoop));
   *this = std::move(restored);
   return true;
 }

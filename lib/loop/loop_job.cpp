@@ -38,6 +38,7 @@ class JobRun {
       if (!accepted.empty()) {
         book_.last_loop_query = job_.query;
         counts_.accepted += static_cast<int>(accepted.size());
+        counts_.partial_loops += static_cast<int>(std::count_if(accepted.begin(), accepted.end(), isPartialLoop));
         book_.accepted.insert(book_.accepted.end(), accepted.begin(), accepted.end());
       }
       return accepted;  // one verified loop per keyframe is enough
@@ -54,16 +55,30 @@ class JobRun {
         scanContextSeed(job_.query_uncorrected, c.match_uncorrected, c.candidate.yaw, config_.level_scan_context),
         T_graph};
     const LoopVerification v = verifyCandidate(job_.query_cloud, c.neighbourhood, seeds, config_.verifier);
-    if (v.verdict == LoopVerdict::kDegenerate) {
+    const bool partial = v.verdict == LoopVerdict::kDegenerate && freeAlongOneAxisOnly(v.icp);
+    if (v.verdict == LoopVerdict::kDegenerate && !partial) {
       ++counts_.rejected_degenerate;
       return std::nullopt;
     }
-    if (v.verdict != LoopVerdict::kAccepted) {
+    if (v.verdict != LoopVerdict::kAccepted && !partial) {
       ++counts_.rejected_fitness;
       return std::nullopt;
     }
-    const Matrix6d loop_cov = loopMeasurementCovariance(config_);
-    const double chi2 = loopChi2(v.T_match_query, T_graph, job_.chain.covarianceBetween(m, job_.query), loop_cov);
+    Eigen::Isometry3d T_match_query = v.T_match_query;
+    Matrix6d loop_cov = loopMeasurementCovariance(config_);
+    if (partial) {
+      // The fit's free axis is in the match keyframe's frame (left perturbation), like the translation of
+      // T_match_query; loop residuals are in the query's.
+      const Eigen::Vector3d axis = v.icp.observability.weakestTranslation().normalized();
+      const double graph_along = axis.dot(T_graph.translation());
+      if (!(std::abs(graph_along) <= config_.partial_loop_max_axis_offset)) {
+        ++counts_.rejected_degenerate;
+        return std::nullopt;
+      }
+      T_match_query.translation() += axis * (graph_along - axis.dot(T_match_query.translation()));
+      loop_cov = partialLoopCovariance(config_, T_match_query.linear().transpose() * axis);
+    }
+    const double chi2 = loopChi2(T_match_query, T_graph, job_.chain.covarianceBetween(m, job_.query), loop_cov);
     if (!(chi2 <= config_.max_odometry_chi2)) {
       ++counts_.rejected_odometry;
       return std::nullopt;
@@ -73,7 +88,7 @@ class JobRun {
     loop.match_index = m;
     loop.query_utime = job_.query_utime;
     loop.match_utime = c.match_utime;
-    loop.T_match_query = v.T_match_query;
+    loop.T_match_query = T_match_query;
     loop.information = loop_cov.inverse();
     loop.scan_context_distance = c.candidate.distance;
     loop.scan_context_yaw = c.candidate.yaw;
@@ -82,13 +97,20 @@ class JobRun {
     return loop;
   }
 
+  // A degenerate fit that still pins both other translations and every rotation.
+  bool freeAlongOneAxisOnly(const IcpResult& fit) const {
+    const FitObservability& pinned = fit.observability;
+    return config_.partial_loops && pinned.middleTranslationRatio() >= config_.verifier.min_eigenvalue_ratio &&
+           pinned.rotation_sigma_rad <= config_.verifier.max_rotation_sigma;
+  }
+
   bool pairConsistent(const LoopConstraint& a, const LoopConstraint& b) const {
     const auto chain = [this](int i, int j) {
       return i <= j ? job_.chain.covarianceBetween(i, j) : job_.chain.covarianceBetween(j, i);
     };
     const Matrix6d cov =
         chain(a.query_index, b.query_index) + chain(a.match_index, b.match_index) +
-        2.0 * loopMeasurementCovariance(config_);
+        a.information.inverse() + b.information.inverse();
     const PoseGraph& g = job_.graph;
     const Eigen::Isometry3d T_ma_mb = g.pose(a.match_index).inverse() * g.pose(b.match_index);
     const Eigen::Isometry3d T_qa_qb = g.pose(a.query_index).inverse() * g.pose(b.query_index);

@@ -101,6 +101,7 @@ class LoopCloserNode : public runtime::Node, public WritesProducts, public Write
     setCount("revisit_keyframes", s.revisit_keyframes);
     setCount("loop_candidates", s.candidates);
     setCount("loops_accepted", s.accepted);
+    setCount("partial_loops", s.partial_loops);
     setCount("rejected_fitness", s.rejected_fitness);
     setCount("rejected_degenerate", s.rejected_degenerate);
     setCount("rejected_odometry_gate", s.rejected_odometry);
