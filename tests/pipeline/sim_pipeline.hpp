@@ -16,6 +16,7 @@
 #include <cmath>
 #include <filesystem>
 #include <functional>
+#include <map>
 #include <string>
 
 namespace adit::test {
@@ -23,6 +24,7 @@ namespace adit::test {
 struct SimPipelineRun {
   Trajectory ground_truth, odometry, corrected;
   Trajectory scan_odometry;  // ODOM_SCAN: scan-to-scan odometry alone (SimPipelineSetup::scan_odometry)
+  std::map<std::string, std::int64_t> odometry_counters;  // the last STATUS_ODOMETRY's
   std::vector<LoopConstraint> loops;
   int false_loops = 0;
   double worst_loop_error_m = 0, worst_loop_error_deg = 0;
@@ -37,14 +39,16 @@ struct SimPipelineSetup {
   std::function<void(sim::SimConfig&)> adjust;  // e.g. motion.start_speed
   bool imu = true;                              // false: the simulator publishes no IMU
   bool scan_odometry = false;                   // also collect ODOM_SCAN's poses (SimPipelineRun::scan_odometry)
+  std::function<void(Config&)> configure;       // pipeline keys beyond launch/config + launch/sensors/sim.yaml
 };
 
 inline SimPipelineRun runSimPipeline(const std::string& world, double duration_s, std::uint64_t seed,
                                      const SimPipelineSetup& setup = {}) {
   namespace fs = std::filesystem;
   const fs::path launch = fs::path(ADIT_SOURCE_DIR) / "launch";
-  const Config config = runtime::loadConfig(
+  Config config = runtime::loadConfig(
       {(launch / "config" / "pipeline.yaml").string(), (launch / "sensors" / "sim.yaml").string()});
+  if (setup.configure) setup.configure(config);
   sim::SimConfig sim = sim::simConfigFrom(config, world, seed);
   sim.duration_s = duration_s;
   if (setup.adjust) setup.adjust(sim);
@@ -59,7 +63,7 @@ inline SimPipelineRun runSimPipeline(const std::string& world, double duration_s
                      ("adit_pipeline_" + world + "_" + std::to_string(::getpid()) + "_" + std::to_string(runs++)))
                         .string();
   options.config = config;
-  options.record = "^LOOP_CLOSURE$";
+  options.record = "^(LOOP_CLOSURE|STATUS_ODOMETRY)$";
   if (setup.scan_odometry) options.record_poses = "^ODOM_SCAN$";
   pipeline::runReplay(options);
 
@@ -74,6 +78,12 @@ inline SimPipelineRun runSimPipeline(const std::string& world, double duration_s
     if (e.channel == "ODOM_SCAN" && scan.decode(e.data.data(), 0, static_cast<int>(e.data.size())) >= 0) {
       const PoseEstimate pose = msg::fromMessage(scan);
       run.scan_odometry.push_back({pose.utime, pose.pose});
+      continue;
+    }
+    if (e.channel == "STATUS_ODOMETRY") {
+      adit::status_t status;
+      if (status.decode(e.data.data(), 0, static_cast<int>(e.data.size())) < 0) continue;
+      for (int i = 0; i < status.num_counters; ++i) run.odometry_counters[status.counter_names[i]] = status.counter_values[i];
       continue;
     }
     adit::loop_closure_t m;
