@@ -116,7 +116,9 @@ class OdometryNode : public runtime::Node {
     if (pose.flags & PoseEstimate::kDegenerateRotation) count("degenerate_rotation");
     if (pose.flags & kPoseHeldToWheel) count("held_to_wheel");
     if (previous_utime >= 0 && !(pose.flags & PoseEstimate::kRegistrationFailed)) {
-      const bool observed = !(pose.flags & PoseEstimate::kDegenerateTranslation);
+      const Eigen::Vector3d& ev = pose.translation_eigenvalues;  // ascending
+      const bool degenerate = (pose.flags & PoseEstimate::kDegenerateTranslation) != 0;
+      const double observed = degenerate || !(ev[2] > 0.0) ? 0.0 : ev[0] / ev[2];
       wheel_.observe(before.inverse() * pose.pose, observed, toSeconds(features.utime - previous_utime), wheel);
     }
     reportWheel();

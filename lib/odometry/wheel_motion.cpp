@@ -35,6 +35,8 @@ const ConfigTable<WheelMotionConfig>& wheelMotionConfigTable() {
      .add("scale_sigma", &W::scale_sigma, above(0), "", "1-sigma of the calibrated slip scale")
      .add("scale_distance_m", &W::scale_distance_m, above(0), "m", "travel the lidar/wheel distance ratio (slip) is averaged over")
      .add("min_calibration_speed", &W::min_calibration_speed, atLeast(0), "m/s", "slower sweeps do not calibrate the scale")
+     .add("calibration_min_ratio", &W::calibration_min_ratio, between(0, 1), "", "translation eigenvalue ratio below which a sweep does not calibrate the slip")
+     .add("calibration_full_ratio", &W::calibration_full_ratio, between(0, 1), "", "ratio from which a sweep calibrates with full weight (and disagreements are judged)")
      .add("scale_sigma_uncalibrated", &W::scale_sigma_uncalibrated, above(0), "", "1-sigma of the scale before any calibration")
      .add("max_disagreement", &W::max_disagreement, above(0), "", "relative difference of wheel and lidar distance beyond which the wheel is distrusted")
      .add("distrust_s", &W::distrust_s, atLeast(0), "s", "how long a disagreement keeps the wheel out")
@@ -133,15 +135,18 @@ std::optional<WheelMotionEstimate> WheelMotion::motion(const std::vector<WheelOd
   return out;
 }
 
-void WheelMotion::observe(const Eigen::Isometry3d& lidar, bool translation_observed, double interval_s,
+void WheelMotion::observe(const Eigen::Isometry3d& lidar, double observed_ratio, double interval_s,
                           const std::optional<WheelMotionEstimate>& wheel) {
   if (!(interval_s > 0.0)) return;
   const double lidar_forward = (R_lidar_base_.transpose() * lidar.translation()).x();
   const double lidar_speed = std::abs(lidar_forward) / interval_s;
-  if (translation_observed) lidar_moving_ = lidar_speed >= config_.min_moving_speed;
-  if (!wheel || !translation_observed || lidar_speed < config_.min_calibration_speed) return;
-  // Both observe the motion: do they agree (after calibration, or within the worst slip before it)?
-  if (std::abs(wheel->distance_m - lidar_forward) > config_.max_disagreement * std::abs(lidar_forward)) {
+  const double span = std::max(1e-9, config_.calibration_full_ratio - config_.calibration_min_ratio);
+  const double weight = std::clamp((observed_ratio - config_.calibration_min_ratio) / span, 0.0, 1.0);
+  if (weight >= 1.0) lidar_moving_ = lidar_speed >= config_.min_moving_speed;
+  if (!wheel || !(weight > 0.0) || lidar_speed < config_.min_calibration_speed) return;
+  // Both observe the motion well: do they agree (after calibration, or within the worst slip before it)?
+  if (weight >= 1.0 &&
+      std::abs(wheel->distance_m - lidar_forward) > config_.max_disagreement * std::abs(lidar_forward)) {
     ++counters_.disagreements;
     distrust_until_ = last_t1_ + toUtime(config_.distrust_s);
     return;
@@ -149,8 +154,10 @@ void WheelMotion::observe(const Eigen::Isometry3d& lidar, bool translation_obser
   if (!(std::abs(wheel->raw_distance_m) > 0.0)) return;
   // Distance-weighted running mean that turns into an exponential average over scale_distance_m.
   const double ratio = lidar_forward / wheel->raw_distance_m;
-  calibrated_distance_m_ = std::min(config_.scale_distance_m, calibrated_distance_m_ + std::abs(wheel->raw_distance_m));
-  scale_ += std::abs(wheel->raw_distance_m) / calibrated_distance_m_ * (ratio - scale_);
+  if (std::abs(ratio - 1.0) > config_.max_disagreement) return;  // weakly observed and implausible
+  const double distance = weight * std::abs(wheel->raw_distance_m);
+  calibrated_distance_m_ = std::min(config_.scale_distance_m, calibrated_distance_m_ + distance);
+  scale_ += distance / calibrated_distance_m_ * (ratio - scale_);
   ++counters_.calibrations;
 }
 

@@ -59,7 +59,7 @@ TEST(WheelMotion, CalibratesSlipWhereTheLidarObservesTheMotion) {
   for (int i = 0; i < 400; ++i, t += 100'000) {
     const auto m = wheel.motion(readings(t, t + 100'000, 1.06, 0.0), t, t + 100'000);
     ASSERT_TRUE(m);
-    wheel.observe(forward(0.1), true, 0.1, m);
+    wheel.observe(forward(0.1), 1.0, 0.1, m);
   }
   EXPECT_TRUE(wheel.calibrated());
   EXPECT_NEAR(wheel.scale(), 1.0 / 1.06, 1e-4);
@@ -67,7 +67,7 @@ TEST(WheelMotion, CalibratesSlipWhereTheLidarObservesTheMotion) {
   const auto m = wheel.motion(readings(t, t + 100'000, 1.06, 0.0), t, t + 100'000);
   ASSERT_TRUE(m);
   EXPECT_NEAR(m->distance_m, 0.1, 1e-4);
-  wheel.observe(forward(0.0), false, 0.1, m);
+  wheel.observe(forward(0.0), 0.0, 0.1, m);
   EXPECT_NEAR(wheel.scale(), 1.0 / 1.06, 1e-4);
   EXPECT_EQ(wheel.counters().calibrations, 400);
 }
@@ -101,7 +101,7 @@ TEST(WheelMotion, FrozenSpeedWhileMovingIsDistrusted) {
     for (auto& s : r) s.speed = 1.0;
     const auto m = wheel.motion(r, t, t + 100'000);
     (m ? used : refused)++;
-    wheel.observe(forward(0.1), true, 0.1, m);
+    wheel.observe(forward(0.1), 1.0, 0.1, m);
   }
   // Used until the value has not changed for stuck_after_s (1 s), refused from then on.
   EXPECT_GE(used, 9);
@@ -114,7 +114,7 @@ TEST(WheelMotion, FrozenSpeedWhileMovingIsDistrusted) {
     for (auto& s : r) s.speed = 0.0;
     const auto m = still.motion(r, t, t + 100'000);
     EXPECT_TRUE(m);
-    still.observe(forward(0.0), true, 0.1, m);
+    still.observe(forward(0.0), 1.0, 0.1, m);
   }
   EXPECT_EQ(still.counters().stuck, 0);
 }
@@ -125,7 +125,7 @@ TEST(WheelMotion, DisagreementWithTheLidarKeepsTheWheelOutForAWhile) {
   // The track spins on mud: the wheel says 2 m/s, the lidar sees 1 m/s.
   auto m = wheel.motion(readings(t, t + 100'000, 2.0, 0.0), t, t + 100'000);
   ASSERT_TRUE(m);
-  wheel.observe(forward(0.1), true, 0.1, m);
+  wheel.observe(forward(0.1), 1.0, 0.1, m);
   EXPECT_EQ(wheel.counters().disagreements, 1);
   EXPECT_EQ(wheel.counters().calibrations, 0);
   EXPECT_NEAR(wheel.scale(), 1.0, 1e-12);  // the bad ratio did not enter the scale
@@ -134,7 +134,7 @@ TEST(WheelMotion, DisagreementWithTheLidarKeepsTheWheelOutForAWhile) {
     t += 100'000;
     m = wheel.motion(readings(t, t + 100'000, 1.0, 0.0), t, t + 100'000);
     if (!m) ++refused;
-    wheel.observe(forward(0.1), true, 0.1, m);
+    wheel.observe(forward(0.1), 1.0, 0.1, m);
   }
   EXPECT_NEAR(refused, 20, 1);  // distrust_s = 2 s, then used (and calibrated) again
   EXPECT_GT(wheel.counters().calibrations, 5);

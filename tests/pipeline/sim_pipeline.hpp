@@ -24,7 +24,7 @@ namespace adit::test {
 struct SimPipelineRun {
   Trajectory ground_truth, odometry, corrected;
   Trajectory scan_odometry;  // ODOM_SCAN: scan-to-scan odometry alone (SimPipelineSetup::scan_odometry)
-  std::map<std::string, std::int64_t> odometry_counters;  // the last STATUS_ODOMETRY's
+  std::map<std::string, std::int64_t> odometry_counters;  // the odometry stage's STATUS counters at the end
   std::vector<LoopConstraint> loops;
   int false_loops = 0;
   double worst_loop_error_m = 0, worst_loop_error_deg = 0;
@@ -63,11 +63,13 @@ inline SimPipelineRun runSimPipeline(const std::string& world, double duration_s
                      ("adit_pipeline_" + world + "_" + std::to_string(::getpid()) + "_" + std::to_string(runs++)))
                         .string();
   options.config = config;
-  options.record = "^(LOOP_CLOSURE|STATUS_ODOMETRY)$";
+  options.record = "^LOOP_CLOSURE$";
   if (setup.scan_odometry) options.record_poses = "^ODOM_SCAN$";
-  pipeline::runReplay(options);
+  const pipeline::ReplayReport report = pipeline::runReplay(options);
 
   SimPipelineRun run;
+  for (const auto& stage : report.timing)
+    if (stage.stage == "odometry") run.odometry_counters = stage.counters;
   run.ground_truth = source.groundTruth();
   run.odometry = eval::readTum(options.out_dir + "/odometry.tum");
   run.corrected = eval::readTum(options.out_dir + "/trajectory.tum");
@@ -78,12 +80,6 @@ inline SimPipelineRun runSimPipeline(const std::string& world, double duration_s
     if (e.channel == "ODOM_SCAN" && scan.decode(e.data.data(), 0, static_cast<int>(e.data.size())) >= 0) {
       const PoseEstimate pose = msg::fromMessage(scan);
       run.scan_odometry.push_back({pose.utime, pose.pose});
-      continue;
-    }
-    if (e.channel == "STATUS_ODOMETRY") {
-      adit::status_t status;
-      if (status.decode(e.data.data(), 0, static_cast<int>(e.data.size())) < 0) continue;
-      for (int i = 0; i < status.num_counters; ++i) run.odometry_counters[status.counter_names[i]] = status.counter_values[i];
       continue;
     }
     adit::loop_closure_t m;
