@@ -76,8 +76,8 @@ TEST(WheelMotion, GapsNonFiniteAndUnorderedReadingsAreCountedNotUsed) {
   WheelMotion wheel;
   const std::int64_t t0 = kStart, t1 = kStart + 100'000;
   auto r = readings(t0, t1, 1.0, 0.0);
-  // A gap of 200 ms: nothing covers the end of the interval.
-  EXPECT_FALSE(wheel.motion({r.begin(), r.begin() + 3}, t0, t1));
+  // Only a reading 20 ms before the interval: nothing within max_gap_s (0.1 s) of its end.
+  EXPECT_FALSE(wheel.motion({r.begin(), r.begin() + 1}, t0, t1));
   EXPECT_EQ(wheel.counters().gaps, 1);
   // NaN readings are skipped; the others still cover the interval.
   WheelMotion w2;
