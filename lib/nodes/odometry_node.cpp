@@ -11,7 +11,6 @@
 #include "odometry/scan_to_scan.hpp"
 #include "odometry/wheel_motion.hpp"
 
-#include <Eigen/Eigenvalues>
 #include <spdlog/spdlog.h>
 
 #include <cmath>
@@ -21,12 +20,10 @@
 namespace adit::nodes {
 namespace {
 
-// The lidar axis (0 x, 1 y, 2 z) nearest to the least-observed translation direction: the covariance's
-// largest-variance eigenvector (a degenerate direction carries the prior's variance, far above the data's).
-int weakestAxis(const Matrix6d& covariance) {
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(Eigen::Matrix3d(covariance.topLeftCorner<3, 3>()));
+// The lidar axis (0 x, 1 y, 2 z) nearest to a direction.
+int nearestAxis(const Eigen::Vector3d& direction) {
   int axis = 0;
-  eig.eigenvectors().col(2).cwiseAbs().maxCoeff(&axis);
+  direction.cwiseAbs().maxCoeff(&axis);
   return axis;
 }
 
@@ -111,7 +108,7 @@ class OdometryNode : public runtime::Node {
     if (pose.flags & PoseEstimate::kRegistrationFailed) count("registration_failed");
     if (pose.flags & PoseEstimate::kDegenerateTranslation) {
       count("degenerate_translation");
-      count(std::string("degenerate_along_") + "xyz"[weakestAxis(pose.covariance)]);
+      count(std::string("degenerate_along_") + "xyz"[nearestAxis(odometry_.weakestTranslationDirection())]);
     }
     if (pose.flags & PoseEstimate::kDegenerateRotation) count("degenerate_rotation");
     if (pose.flags & kPoseHeldToWheel) count("held_to_wheel");

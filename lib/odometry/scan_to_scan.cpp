@@ -357,6 +357,7 @@ PoseEstimate ScanToScanOdometry::process(const FeatureSet& f, const std::optiona
     RegistrationConfig reported = config_.registration;
     if (held_to_measured) reported.prior_sigma_translation_m = measured->sigma_translation_m;
     reportRegistration(r.result, reported, out);
+    weakest_translation_ = r.result.degeneracy.translation_directions.col(0);
     if (held_to_measured && (r.result.degeneracy.flags & PoseEstimate::kDegenerateTranslation))
       out.flags |= kPoseHeldToWheel;
   } else {

@@ -147,6 +147,9 @@ class ScanToScanOdometry {
   // speeds up: measured 1.1 m short over a 1.9 s restart gap while accelerating).
   Vector6d lastVelocity() const;
   std::int64_t lastUtime() const { return has_previous_ ? previous_utime_ : -1; }
+  // The last registration's least-observed translation direction (lidar frame; its degeneracy analysis),
+  // whatever held it: a covariance held to the wheel no longer shows it.
+  const Eigen::Vector3d& weakestTranslationDirection() const { return weakest_translation_; }
   void reset();
   // Starts over (no previous sweep, no velocity) but at `pose` instead of the identity: after a restart or a
   // gap in the input, the odometry frame continues where it was.
@@ -196,6 +199,7 @@ class ScanToScanOdometry {
   Eigen::Isometry3d last_motion_ = Eigen::Isometry3d::Identity();  // T_prev_curr of the previous step
   std::int64_t last_gap_us_ = 0;                                   // 0: no velocity estimate yet
   Vector6d held_velocity_ = Vector6d::Zero();  // averaged tangent velocity (per second), see predictHeldMotion
+  Eigen::Vector3d weakest_translation_ = Eigen::Vector3d::UnitX();
   void updateHeldVelocity(const Eigen::Isometry3d& T_prev_curr, std::int64_t gap_us,
                           const Matrix6d* information = nullptr);
 };
