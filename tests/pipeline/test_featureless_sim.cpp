@@ -30,12 +30,7 @@ EndError endError(const Trajectory& gt, const Trajectory& est) {
 TEST(FeaturelessSim, WheelOdometryCarriesTheUnobservedAxis) {
   test::SimPipelineSetup setup;
   setup.adjust = [](sim::SimConfig& c) { c.wheel.enabled = true; };
-  setup.configure = [](Config& c) {
-    // The world goes into the configuration: simConfigFrom builds its geometry from sim.world and sim.seed.
-    c.set("sim.world", "featureless");
-    c.set("sim.seed", "1");
-    c.set("features.preprocess.max_range", "30");
-  };
+  setup.configure = [](Config& c) { c.set("features.preprocess.max_range", "30"); };
   // 60 s: 2 s standing, ~28 m with the near dead end in range (slip calibrated), then ~45 m without.
   const auto run = test::runSimPipeline("featureless", 60.0, 1, setup);
   ASSERT_EQ(run.corrected.size(), run.ground_truth.size());
