@@ -111,6 +111,19 @@ ImuSample fromMessage(const adit::imu_t& m) {
   return imu;
 }
 
+adit::wheel_odom_t toMessage(const WheelOdomSample& w) {
+  adit::wheel_odom_t m;
+  m.header = makeHeader(w.utime, "base");
+  m.speed = w.speed;
+  m.yaw_rate = w.yaw_rate;
+  m.speed_sigma = w.speed_sigma;
+  m.yaw_rate_sigma = w.yaw_rate_sigma;
+  return m;
+}
+
+WheelOdomSample fromMessage(const adit::wheel_odom_t& m) {
+  return {m.header.utime, m.speed, m.yaw_rate, m.speed_sigma, m.yaw_rate_sigma};
+}
 
 adit::features_t toMessage(const FeatureSet& f) {
   adit::features_t m;

@@ -3,6 +3,7 @@
 #pragma once
 
 #include "core/types.hpp"
+#include "core/wheel_odom.hpp"
 #include "msg/point_set.hpp"
 
 #include <adit/features_t.hpp>
@@ -10,6 +11,7 @@
 #include <adit/loop_closure_t.hpp>
 #include <adit/odometry_t.hpp>
 #include <adit/point_cloud_t.hpp>
+#include <adit/wheel_odom_t.hpp>
 
 namespace adit::msg {
 
@@ -23,6 +25,8 @@ std::vector<LidarPoint> pointsFromMessage(const adit::point_cloud_t& msg);
 
 adit::imu_t toMessage(const ImuSample& imu);
 ImuSample fromMessage(const adit::imu_t& msg);
+adit::wheel_odom_t toMessage(const WheelOdomSample& wheel);
+WheelOdomSample fromMessage(const adit::wheel_odom_t& msg);
 
 // LinK3D descriptor bins on FEATURES: int16 counts of 2 mm (to 65 m), a hundredth of the 0.2 m bin tolerance.
 constexpr float kDescriptorScale = 0.002f;

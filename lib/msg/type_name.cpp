@@ -2,6 +2,7 @@
 
 #include <adit/features_t.hpp>
 #include <adit/imu_t.hpp>
+#include <adit/wheel_odom_t.hpp>
 #include <adit/lidar_scan_t.hpp>
 #include <adit/loop_closure_t.hpp>
 #include <adit/map_update_t.hpp>
@@ -27,6 +28,7 @@ std::string messageTypeName(const std::uint8_t* data, std::size_t size) {
   if (hasHash<adit::lidar_scan_t>(hash)) return "lidar_scan_t";
   if (hasHash<adit::point_cloud_t>(hash)) return "point_cloud_t";
   if (hasHash<adit::imu_t>(hash)) return "imu_t";
+  if (hasHash<adit::wheel_odom_t>(hash)) return "wheel_odom_t";
   if (hasHash<adit::features_t>(hash)) return "features_t";
   if (hasHash<adit::odometry_t>(hash)) return "odometry_t";
   if (hasHash<adit::loop_closure_t>(hash)) return "loop_closure_t";

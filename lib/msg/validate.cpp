@@ -29,6 +29,13 @@ class Check {
       fail("invalid_range", std::string(field) + " magnitude exceeds " + std::to_string(limit));
     return *this;
   }
+  // A scalar (after it was found finite) within [lo, hi].
+  Check& within(const char* field, double v, double lo, double hi) {
+    if (!failed() && (v < lo || v > hi))
+      fail("invalid_range", std::string(field) + " = " + std::to_string(v) + " is outside [" + std::to_string(lo) +
+                                ", " + std::to_string(hi) + "]");
+    return *this;
+  }
   Check& position(const char* field, const double* p) {
     finite(field, p, 3);
     return norm3(field, p, limits_.max_position);
@@ -113,6 +120,18 @@ Validation validate(const adit::imu_t& m, const InputLimits& limits) {
   if (m.has_magnetometer)
     c.finite("magnetic_field", m.magnetic_field, 3).norm3("magnetic_field", m.magnetic_field, limits.max_magnetic_field);
   if (m.has_orientation) c.quaternion("orientation", m.orientation);
+  return c.result();
+}
+
+Validation validate(const adit::wheel_odom_t& m, const InputLimits& limits) {
+  Check c(limits);
+  c.merge(validate(m.header, limits));
+  c.finite("speed", m.speed).within("speed", m.speed, -limits.max_wheel_speed, limits.max_wheel_speed);
+  c.finite("yaw_rate", m.yaw_rate)
+      .within("yaw_rate", m.yaw_rate, -limits.max_angular_velocity, limits.max_angular_velocity);
+  c.finite("speed_sigma", m.speed_sigma).within("speed_sigma", m.speed_sigma, 0.0, limits.max_wheel_speed);
+  c.finite("yaw_rate_sigma", m.yaw_rate_sigma)
+      .within("yaw_rate_sigma", m.yaw_rate_sigma, 0.0, limits.max_angular_velocity);
   return c.result();
 }
 

@@ -15,6 +15,7 @@
 #include <adit/point_set_t.hpp>
 #include <adit/pose_graph_t.hpp>
 #include <adit/status_t.hpp>
+#include <adit/wheel_odom_t.hpp>
 
 #include <optional>
 #include <string>
@@ -25,6 +26,7 @@ namespace adit::msg {
 struct InputLimits {
   double max_angular_velocity = 40.0;    // rad/s (2000 deg/s = 34.9 rad/s full scale)
   double max_acceleration = 200.0;       // m/s^2 (16 g full scale = 157 m/s^2)
+  double max_wheel_speed = 50.0;         // m/s of wheel odometry (a road vehicle's 180 km/h)
   double max_magnetic_field = 1e-3;      // tesla (the Earth's field is ~5e-5)
   double quaternion_tolerance = 1e-3;    // allowed | |q| - 1 |
   double max_position = 1e6;             // metres from the origin
@@ -41,6 +43,7 @@ using Validation = std::optional<Invalid>;  // empty: the message is usable
 
 Validation validate(const adit::header_t& m, const InputLimits& limits);
 Validation validate(const adit::imu_t& m, const InputLimits& limits);
+Validation validate(const adit::wheel_odom_t& m, const InputLimits& limits);
 Validation validate(const adit::point_cloud_t& m, const InputLimits& limits);
 Validation validate(const adit::features_t& m, const InputLimits& limits);
 Validation validate(const adit::odometry_t& m, const InputLimits& limits);

@@ -4,7 +4,7 @@
 #include "features/preprocess.hpp"
 #include "msg/convert.hpp"
 #include "msg/sweep_codec.hpp"
-#include "nodes/imu_buffer.hpp"
+#include "nodes/sample_buffer.hpp"
 #include "nodes/node_config.hpp"
 
 #include <deque>

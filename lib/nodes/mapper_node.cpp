@@ -3,6 +3,7 @@
 #include "core/byte_codec.hpp"
 #include "core/geometry.hpp"
 #include "eval/trajectory_io.hpp"
+#include "io/atomic_file.hpp"
 #include "io/pcd.hpp"
 #include "features/preprocess.hpp"
 #include "mapping/scan_to_map.hpp"
@@ -14,6 +15,7 @@
 #include <adit/pose_graph_t.hpp>
 #include <spdlog/spdlog.h>
 
+#include <cstdio>
 #include <filesystem>
 
 namespace adit::nodes {
@@ -42,13 +44,15 @@ class MapperNode : public runtime::Node, public WritesProducts {
     const std::string odometry = (fs::path(out_dir) / "odometry.tum").string();
     const std::string trajectory = (fs::path(out_dir) / "trajectory.tum").string();
     const std::string map = (fs::path(out_dir) / "map.pcd").string();
+    const std::string covariance = (fs::path(out_dir) / "covariance.txt").string();
     eval::writeTum(odometry, uncorrected_);
     eval::writeTum(trajectory, corrected_);
-    if (!mapper_.keepsGlobalMap()) return {odometry, trajectory};
+    io::writeFileAtomically(covariance, covarianceText());
+    if (!mapper_.keepsGlobalMap()) return {odometry, trajectory, covariance};
     std::vector<LidarPoint> points;
     for (const auto& p : mapper_.globalMap(map_voxel_)) points.push_back({p, 0.0f, 0, 0.0f});
     io::writePcd(map, points);
-    return {odometry, trajectory, map};
+    return {odometry, trajectory, covariance, map};
   }
   bool writesMap() const override { return mapper_.keepsGlobalMap(); }
   // The loop closer's map (corrected keyframes) replaces ours: the global map would only cost memory.
@@ -102,12 +106,31 @@ class MapperNode : public runtime::Node, public WritesProducts {
     if (!state_.live()) {  // the per-sweep trajectories are replay's products only
       corrected_.push_back({mapped.utime, mapped.pose});
       uncorrected_.push_back({mapped.utime, applied_.inverse() * mapped.pose});
+      covariances_.push_back({mapped.utime, mapped.covariance, mapped.flags});
     }
     if (state_.live() && checkpoint_period_us_ > 0 && mapped.utime - last_checkpoint_utime_ >= checkpoint_period_us_) {
       checkpoint();
       last_checkpoint_utime_ = mapped.utime;
     }
     reportCheckpoints();
+  }
+
+  // covariance.txt: per mapped pose its time (s, as in the TUM files), degeneracy flags (odometry_t's bits) and
+  // the 6x6 covariance row-major, lidar frame, tangent order (tx ty tz rx ry rz). A degenerate direction
+  // carries the variance of what held it (motion model or wheel), never the data's near-infinite one.
+  std::string covarianceText() const {
+    std::string text = "# t flags c00 c01 ... c55 (row-major 6x6, lidar frame, tx ty tz rx ry rz; m^2, m rad, rad^2)\n";
+    char buf[64];
+    for (const PoseCovariance& c : covariances_) {
+      std::snprintf(buf, sizeof buf, "%.6f %d", toSeconds(c.utime), c.flags);
+      text += buf;
+      for (int i = 0; i < 36; ++i) {
+        std::snprintf(buf, sizeof buf, " %.6g", c.covariance(i / 6, i % 6));
+        text += buf;
+      }
+      text += '\n';
+    }
+    return text;
   }
 
   // The graph's correction is total (relative to uncorrected poses); apply what is new to us.
@@ -163,6 +186,12 @@ class MapperNode : public runtime::Node, public WritesProducts {
   RunState state_;
   Eigen::Isometry3d applied_ = Eigen::Isometry3d::Identity();  // total loop correction applied so far
   Trajectory corrected_, uncorrected_;
+  struct PoseCovariance {
+    std::int64_t utime = 0;
+    Matrix6d covariance;
+    std::int32_t flags = 0;
+  };
+  std::vector<PoseCovariance> covariances_;
 };
 
 }  // namespace

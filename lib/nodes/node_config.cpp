@@ -7,6 +7,7 @@
 #include "mapping/scan_to_map.hpp"
 #include "odometry/initial_guess.hpp"
 #include "odometry/scan_to_scan.hpp"
+#include "odometry/wheel_motion.hpp"
 
 namespace adit::nodes {
 
@@ -22,7 +23,8 @@ const ConfigTable<InputCheckConfig>& inputCheckConfigTable() {
      .add("max_string_bytes", &N::max_string_bytes, atLeast(1), "B", "largest string a message may announce on the wire")
      .add("max_text_length", &N::max_text_length, atLeast(1), "B", "longest text field accepted (command arguments, frame ids, STATUS text)")
      .add("max_angular_velocity", &N::max_angular_velocity, above(0), "rad/s", "IMU rates beyond this are refused as invalid_range")
-     .add("max_acceleration", &N::max_acceleration, above(0), "m/s^2", "IMU accelerations beyond this are refused as invalid_range");
+     .add("max_acceleration", &N::max_acceleration, above(0), "m/s^2", "IMU accelerations beyond this are refused as invalid_range")
+     .add("max_wheel_speed", &N::max_wheel_speed, above(0), "m/s", "wheel odometry speeds beyond this are refused as invalid_range");
     return t;
   }();
   return table;
@@ -40,6 +42,7 @@ runtime::InputChecks inputChecksFrom(const Config& config) {
   checks.values.max_string_length = static_cast<std::size_t>(c.max_text_length);
   checks.values.max_angular_velocity = c.max_angular_velocity;
   checks.values.max_acceleration = c.max_acceleration;
+  checks.values.max_wheel_speed = c.max_wheel_speed;
   return checks;
 }
 
@@ -122,6 +125,7 @@ std::vector<ConfigKeyInfo> pipelineConfigDescription(const Config& c) {
   describeInto(featureConfigTable(), featureConfigFrom(c), keys);
   describeInto(scanToScanConfigTable(), scanToScanConfigFrom(c), keys);
   describeInto(initialGuessConfigTable(), initialGuessConfigFrom(c), keys);
+  describeInto(wheelMotionConfigTable(), wheelMotionConfigTable().read(c), keys);
   describeInto(mapperConfigTable(), mapperConfigFrom(c), keys);
   describeInto(loopCloserConfigTable(), loopCloserConfigFrom(c), keys);
   describeInto(featureNodeConfigTable(), featureNodeConfigTable().read(c), keys);

@@ -65,6 +65,7 @@ struct InputCheckConfig {
   int max_text_length = static_cast<int>(msg::InputLimits{}.max_string_length);
   double max_angular_velocity = msg::InputLimits{}.max_angular_velocity;
   double max_acceleration = msg::InputLimits{}.max_acceleration;
+  double max_wheel_speed = msg::InputLimits{}.max_wheel_speed;
 };
 
 const ConfigTable<InputCheckConfig>& inputCheckConfigTable();

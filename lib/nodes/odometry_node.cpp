@@ -3,20 +3,29 @@
 #include "core/byte_codec.hpp"
 #include "features/preprocess.hpp"
 #include "msg/convert.hpp"
-#include "nodes/imu_buffer.hpp"
+#include "nodes/sample_buffer.hpp"
 #include "nodes/node_config.hpp"
 #include "nodes/run_state.hpp"
 #include "odometry/initial_guess.hpp"
 #include "registration/pose_increment.hpp"
 #include "odometry/scan_to_scan.hpp"
+#include "odometry/wheel_motion.hpp"
 
 #include <spdlog/spdlog.h>
 
+#include <cmath>
 #include <deque>
 #include <optional>
 
 namespace adit::nodes {
 namespace {
+
+// The lidar axis (0 x, 1 y, 2 z) nearest to a direction.
+int nearestAxis(const Eigen::Vector3d& direction) {
+  int axis = 0;
+  direction.cwiseAbs().maxCoeff(&axis);
+  return axis;
+}
 
 class OdometryNode : public runtime::Node {
  public:
@@ -25,6 +34,8 @@ class OdometryNode : public runtime::Node {
         odometry_(scanToScanConfigFrom(config)),
         guess_config_(initialGuessConfigFrom(config)),
         imu_(odometryNodeConfigTable().read(config).imu_keep_s),
+        wheel_buffer_(odometryNodeConfigTable().read(config).imu_keep_s),
+        wheel_(wheelMotionConfigTable().read(config)),
         state_("odometry") {
     const OdometryNodeConfig node = odometryNodeConfigTable().read(config);
     forward_voxel_ = node.forward_cloud_voxel;
@@ -32,6 +43,8 @@ class OdometryNode : public runtime::Node {
     max_extrapolation_s_ = node.max_extrapolation_s;
     subscribe<adit::features_t>("features", "FEATURES", [this](const adit::features_t& m) { onFeatures(m); });
     subscribe<adit::imu_t>("imu", "IMU", [this](const adit::imu_t& m) { imu_.add(m); });
+    // Optional: a robot without wheel odometry publishes nothing here.
+    subscribe<adit::wheel_odom_t>("wheel", "WHEEL_ODOM", [this](const adit::wheel_odom_t& m) { wheel_buffer_.add(m); });
     advertise("odometry", "ODOM_SCAN");
   }
 
@@ -60,6 +73,7 @@ class OdometryNode : public runtime::Node {
   // itself resumes from its checkpoint (useRunFolder).
   void onTimeJump(const std::string& port) override {
     if (port == "imu") imu_.clear();
+    if (port == "wheel") wheel_buffer_.clear();
   }
 
   void onFinish() override {
@@ -85,9 +99,26 @@ class OdometryNode : public runtime::Node {
     count("link3d_matches", guess.link3d_matches);
     if (guess.flags & PoseEstimate::kSeededByLinK3d) count("seeded_by_link3d");
     if (guess.flags & PoseEstimate::kSeededByImu) count("seeded_by_imu");
-    const PoseEstimate pose = odometry_.process(features, guess.T_prev_curr, guess.flags);
+    const std::optional<WheelMotionEstimate> wheel = wheelMotion(features.utime, guess);
+    const Eigen::Isometry3d before = odometry_.pose();
+    const std::int64_t previous_utime = odometry_.lastUtime();
+    const PoseEstimate pose = odometry_.process(
+        features, guess.T_prev_curr, guess.flags,
+        wheel ? std::optional<MeasuredMotion>(MeasuredMotion{wheel->T_prev_curr, wheel->sigma_translation_m}) : std::nullopt);
     if (pose.flags & PoseEstimate::kRegistrationFailed) count("registration_failed");
-    if (pose.flags & PoseEstimate::kDegenerateTranslation) count("degenerate_translation");
+    if (pose.flags & PoseEstimate::kDegenerateTranslation) {
+      count("degenerate_translation");
+      count(std::string("degenerate_along_") + "xyz"[nearestAxis(odometry_.weakestTranslationDirection())]);
+    }
+    if (pose.flags & PoseEstimate::kDegenerateRotation) count("degenerate_rotation");
+    if (pose.flags & kPoseHeldToWheel) count("held_to_wheel");
+    if (previous_utime >= 0 && !(pose.flags & PoseEstimate::kRegistrationFailed)) {
+      const Eigen::Vector3d& ev = pose.translation_eigenvalues;  // ascending
+      const bool degenerate = (pose.flags & PoseEstimate::kDegenerateTranslation) != 0;
+      const double observed = degenerate || !(ev[2] > 0.0) ? 0.0 : ev[0] / ev[2];
+      wheel_.observe(before.inverse() * pose.pose, observed, toSeconds(features.utime - previous_utime), wheel);
+    }
+    reportWheel();
     previous_ = features;
     // The mapper needs the less-sharp / less-flat sets and the thinned sweep (odometry_t carries only those).
     features.corner_sharp.clear();
@@ -98,6 +129,30 @@ class OdometryNode : public runtime::Node {
     publish("odometry", out);
     if (state_.live() && pose.utime - last_checkpoint_utime_ >= checkpoint_period_us_) checkpoint();
     reportCheckpoints();
+  }
+
+  // The wheel's motion since the previous sweep (none without WHEEL_ODOM, before two sweeps, or when the
+  // readings are distrusted), with the IMU's rotation when the seed has one.
+  std::optional<WheelMotionEstimate> wheelMotion(std::int64_t utime, const InitialGuess& guess) {
+    const std::int64_t previous = odometry_.lastUtime();
+    if (wheel_buffer_.empty() || previous < 0) return std::nullopt;
+    std::optional<Eigen::Matrix3d> rotation;
+    if (guess.T_prev_curr && (guess.flags & PoseEstimate::kSeededByImu)) rotation = guess.T_prev_curr->linear();
+    return wheel_.motion(wheel_buffer_.samples(), previous, utime, rotation);
+  }
+
+  void reportWheel() {
+    const WheelCounters& c = wheel_.counters();
+    if (c.used + c.gaps + c.distrusted + c.nonfinite + c.unordered == 0) return;  // no wheel on this robot
+    setCount("wheel_used", c.used);
+    setCount("wheel_calibrations", c.calibrations);
+    setCount("wheel_gap", c.gaps);
+    setCount("wheel_stuck", c.stuck);
+    setCount("wheel_disagrees", c.disagreements);
+    setCount("wheel_distrusted", c.distrusted);
+    setCount("wheel_nonfinite", c.nonfinite);
+    setCount("wheel_unordered", c.unordered);
+    setCount("wheel_scale_ppm", static_cast<std::int64_t>(std::lround(wheel_.scale() * 1e6)));
   }
 
   void resumeFrom(const Resume& r, std::int64_t utime) {
@@ -139,6 +194,8 @@ class OdometryNode : public runtime::Node {
   ScanToScanOdometry odometry_;
   InitialGuessConfig guess_config_;
   ImuBuffer imu_;
+  WheelBuffer wheel_buffer_;
+  WheelMotion wheel_;
   double forward_voxel_ = 0.1;
   std::int64_t checkpoint_period_us_ = 500000;
   double max_extrapolation_s_ = 5.0;

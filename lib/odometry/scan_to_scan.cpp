@@ -1,6 +1,7 @@
 #include "odometry/scan_to_scan.hpp"
 
 #include "registration/feature_fit.hpp"
+#include "core/wheel_odom.hpp"
 #include "odometry/motion_compensation.hpp"
 #include "odometry/startup_search.hpp"
 #include "registration/parallel_matching.hpp"
@@ -69,6 +70,7 @@ const ConfigTable<ScanToScanConfig>& scanToScanConfigTable() {
      .add("use_link3d_seed", &S::use_link3d_seed, anyValue(), "", "seed from LinK3D matches (false: motion model only, A-LOAM)")
      .add("max_velocity_gap_s", &S::max_velocity_gap_s, above(0), "s", "longest gap over which the constant-velocity model extrapolates")
      .add("hold_velocity_time_constant_s", &S::hold_velocity_time_constant_s, atLeast(0), "s", "averaging of the velocity degenerate directions hold to; 0 = last motion")
+     .add("hold_velocity_observed_ratio", &S::hold_velocity_observed_ratio, between(0, 1), "", "that average weighs a translation direction fully from this eigenvalue ratio on (all residuals), not at all where degenerate; 0 = unweighted")
      .add("startup_max_speed_mps", &S::startup_max_speed_mps, atLeast(0), "m/s", "fastest a vehicle may already move when odometry starts (start-up search range; 0 = no search)")
      .add("startup_search_step_m", &S::startup_search_step_m, above(0), "m", "spacing of the start-up search's seeds along the forward axis")
      .add("startup_inlier_distance_m", &S::startup_inlier_distance_m, above(0), "m", "residual below which a correspondence counts for a start-up seed");
@@ -116,14 +118,34 @@ Eigen::Isometry3d ScanToScanOdometry::predictHeldMotion(std::int64_t utime) cons
   return applyIncrement(Eigen::Isometry3d::Identity(), held_velocity_ * toSeconds(utime - previous_utime_));
 }
 
-void ScanToScanOdometry::updateHeldVelocity(const Eigen::Isometry3d& T_prev_curr, std::int64_t gap_us) {
+void ScanToScanOdometry::updateHeldVelocity(const Eigen::Isometry3d& T_prev_curr, std::int64_t gap_us,
+                                            const Matrix6d* information) {
   const double gap_s = toSeconds(gap_us);
   if (!(gap_s > 0.0)) return;
   const Vector6d velocity = incrementBetween(Eigen::Isometry3d::Identity(), T_prev_curr) / gap_s;
   const double tau = config_.hold_velocity_time_constant_s;
   // The first velocity (none known before) is taken as it is; then an exponential average.
-  const double alpha = (last_gap_us_ == 0 || !(tau > 0.0)) ? 1.0 : 1.0 - std::exp(-gap_s / tau);
-  held_velocity_ += alpha * (velocity - held_velocity_);
+  const bool first = last_gap_us_ == 0;
+  const double alpha = (first || !(tau > 0.0)) ? 1.0 : 1.0 - std::exp(-gap_s / tau);
+  const Vector6d change = velocity - held_velocity_;
+  held_velocity_.tail<3>() += alpha * change.tail<3>();
+  const double full = config_.hold_velocity_observed_ratio, none = config_.registration.degeneracy_ratio_translation;
+  // Observed by every residual (edges too), not only the planes the degeneracy flag is judged from: where
+  // arches, bolts and equipment pin the roadway's axis its planes alone look weak (0.02-0.04 of the largest
+  // eigenvalue on roadway-loop, where all residuals give 0.22-0.36), and down-weighting those sweeps let the
+  // held speed lag the robot's real accelerations (roadway-loop 20 s APE 0.011 -> 0.020 m).
+  const DegeneracyReport observed = information ? analyzeDegeneracy(*information, none, 0.0) : DegeneracyReport{};
+  const double largest = observed.translation_eigenvalues[2];
+  if (first || !information || !(full > none) || !(largest > 0.0)) {
+    held_velocity_.head<3>() += alpha * change.head<3>();
+    return;
+  }
+  for (int i = 0; i < 3; ++i) {  // per translation eigen-direction, weighted by how well it was observed
+    const Eigen::Vector3d d = observed.translation_directions.col(i);
+    const double ratio = observed.translation_eigenvalues[i] / largest;
+    const double weight = std::clamp((ratio - none) / (full - none), 0.0, 1.0);
+    held_velocity_.head<3>() += d * (alpha * weight * d.dot(change.head<3>()));
+  }
 }
 
 std::optional<LineFit> ScanToScanOdometry::fitLocalLine(const Eigen::Vector3d& q, double max_sq) const {
@@ -275,7 +297,7 @@ void ScanToScanOdometry::awaitPrevious() const {
 }
 
 PoseEstimate ScanToScanOdometry::process(const FeatureSet& f, const std::optional<Eigen::Isometry3d>& prior,
-                                         int prior_flags) {
+                                         int prior_flags, const std::optional<MeasuredMotion>& measured) {
   PoseEstimate out;
   out.utime = f.utime;
   const Eigen::Isometry3d motion_model = predictMotion(f.utime);
@@ -291,10 +313,14 @@ PoseEstimate ScanToScanOdometry::process(const FeatureSet& f, const std::optiona
   // Along degenerate directions hold to the motion model (IMU-aided if the prior came from the IMU), never
   // to a LinK3D seed: that one is measured from the same, degenerate, geometry.
   const bool imu_prior = prior_usable && (prior_flags & PoseEstimate::kSeededByImu) != 0;
-  const Eigen::Isometry3d hold = imu_prior ? *prior : predictHeldMotion(f.utime);
+  // A measured motion (wheel odometry) observes what the lidar cannot: hold to it first.
+  const bool held_to_measured = measured && isFinitePose(measured->T_prev_curr);
+  const Eigen::Isometry3d hold = held_to_measured ? measured->T_prev_curr
+                                 : imu_prior      ? *prior
+                                                  : predictHeldMotion(f.utime);
   // Before a velocity is known the motion model says nothing (its identity is not "standing still"):
   // holding a degenerate direction to it would pin the estimate at zero motion.
-  const bool can_hold = imu_prior || hasVelocity(f.utime);
+  const bool can_hold = held_to_measured || imu_prior || hasVelocity(f.utime);
 
   SweepPoints cur{f.corner_sharp, f.surf_flat, f.corner_less_sharp, f.surf_less_flat};
   const bool cur_raw = !f.cloud.deskewed;
@@ -328,7 +354,12 @@ PoseEstimate ScanToScanOdometry::process(const FeatureSet& f, const std::optiona
   out.iterations = r.iterations;
   Eigen::Isometry3d T = r.pose;
   if (has_previous_ && r.ok) {
-    reportRegistration(r.result, config_.registration, out);
+    RegistrationConfig reported = config_.registration;
+    if (held_to_measured) reported.prior_sigma_translation_m = measured->sigma_translation_m;
+    reportRegistration(r.result, reported, out);
+    weakest_translation_ = r.result.degeneracy.translation_directions.col(0);
+    if (held_to_measured && (r.result.degeneracy.flags & PoseEstimate::kDegenerateTranslation))
+      out.flags |= kPoseHeldToWheel;
   } else {
     T = seed;
     out.covariance = priorCovariance(config_.registration);
@@ -337,7 +368,7 @@ PoseEstimate ScanToScanOdometry::process(const FeatureSet& f, const std::optiona
   }
 
   if (has_previous_) {
-    updateHeldVelocity(T, f.utime - previous_utime_);
+    updateHeldVelocity(T, f.utime - previous_utime_, r.ok ? &r.result.information : nullptr);
     last_motion_ = T;
     last_gap_us_ = f.utime - previous_utime_;
     pose_ = pose_ * T;

@@ -56,6 +56,12 @@ std::string timingJson(const ReplayReport& r) {
                        "\"cpu_median_ms\": {:.3f}, \"cpu_p95_ms\": {:.3f}, \"wall_total_ms\": {:.1f}, \"cpu_total_ms\": {:.1f}}}",
                        i ? "," : "", t.stage, t.calls, t.median_ms, t.p95_ms, t.max_ms, t.cpu_median_ms, t.cpu_p95_ms,
                        t.wall_total_ms, t.cpu_total_ms);
+    if (t.counters.empty()) continue;
+    out.pop_back();  // the stage's closing brace: its counters go inside
+    out += ", \"counters\": {";
+    for (auto it = t.counters.begin(); it != t.counters.end(); ++it)
+      out += fmt::format("{}\"{}\": {}", it == t.counters.begin() ? "" : ", ", it->first, it->second);
+    out += "}}";
   }
   out += fmt::format(
       "\n  }},\n  \"sweeps\": {},\n  \"sensor_seconds\": {:.3f},\n  \"wall_seconds\": {:.3f},\n"
@@ -204,7 +210,7 @@ ReplayReport runReplay(const ReplayOptions& options) {
     const auto& t = node->timing();
     const auto& cpu = node->cpuTiming();
     report.timing.push_back({node->name(), t.size(), t.quantile(0.5), t.quantile(0.95), t.max(), cpu.quantile(0.5),
-                             cpu.quantile(0.95), node->wallMsTotal(), node->cpuMsTotal()});
+                             cpu.quantile(0.95), node->wallMsTotal(), node->cpuMsTotal(), node->health().counters});
     report.stage_errors += node->health().errors + node->health().drops;
   }
   report.sensor_seconds = first_utime >= 0 ? static_cast<double>(last_utime - first_utime) * 1e-6 : 0.0;

@@ -11,6 +11,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -46,6 +47,7 @@ struct StageTiming {
   double median_ms = 0, p95_ms = 0, max_ms = 0;  // wall time of the stage's main input (a sweep)
   double cpu_median_ms = 0, cpu_p95_ms = 0;       // CPU time of the same calls (the stage's thread)
   double wall_total_ms = 0, cpu_total_ms = 0;     // over every input of the stage
+  std::map<std::string, std::int64_t> counters;   // the stage's STATUS counters at the end of the run
 };
 
 struct ReplayReport {

@@ -22,7 +22,7 @@ inline std::uint64_t mix64(std::uint64_t z) {
 }
 
 // Stream ids of the simulator's independent random sources.
-enum class Stream : std::uint64_t { World = 1, Motion = 2, Imu = 3, LidarSweep = 4, WorldCloud = 5 };
+enum class Stream : std::uint64_t { World = 1, Motion = 2, Imu = 3, LidarSweep = 4, WorldCloud = 5, Wheel = 6 };
 
 class Rng {
  public:

@@ -24,6 +24,7 @@
 #include "sim/imu_model.hpp"
 #include "sim/lidar_model.hpp"
 #include "sim/motion.hpp"
+#include "sim/wheel_model.hpp"
 #include "sim/world.hpp"
 
 #include <cstdint>
@@ -46,25 +47,27 @@ struct SimConfig {
   MotionConfig motion;
   LidarNoiseConfig lidar;
   ImuConfig imu;
+  WheelOdomConfig wheel;  // wheel / track odometry (off by default: not every robot has it)
   // Test hook: every firing of a sweep uses the pose at the sweep's utime (no motion distortion).
   bool freeze_sweep_motion = false;
 };
 
 // Keys: sim.world, sim.sensor, sim.duration, sim.seed, sim.start_utime, sim.dust (shortcut for sim.lidar.dust),
 // sim.roadway.* (WorldConfig fields), sim.motion.* (MotionConfig), sim.lidar.* (LidarNoiseConfig),
-// sim.imu.* (ImuConfig); every default as documented on the structs (launch/worlds/roadway-loop.yaml lists them
+// sim.imu.* (ImuConfig), sim.wheel.* (WheelOdomConfig); every default as documented on the structs (launch/worlds/roadway-loop.yaml lists them
 // all). Throws std::invalid_argument for an unknown world, std::runtime_error for a value that does not parse.
 SimConfig simConfigFrom(const adit::Config& c);
 // The same with sim.world and sim.seed replaced before the world's geometry is resolved.
 SimConfig simConfigFrom(adit::Config c, const std::string& world, std::uint64_t seed);
 
 struct SimEvent {
-  enum class Kind { Scan, Imu };
+  enum class Kind { Scan, Imu, Wheel };
   Kind kind = Kind::Imu;
   LidarScan scan;      // Kind::Scan
   ImuSample imu;       // Kind::Imu
   StampedPose truth;   // T_world_lidar at scan.utime (Scan) or at the sample time (Imu)
   ImuTruth imu_truth;  // Kind::Imu: biases and exact state
+  WheelOdomSample wheel;  // Kind::Wheel (only with config.wheel.enabled)
 };
 
 class Simulator {
@@ -107,9 +110,12 @@ class Simulator {
   LidarSimulator lidar_;
   mutable LocalRayCaster caster_;  // crop of the world around the sensor; a cache, results do not depend on it
   ImuSimulator imu_;
+  WheelOdomSimulator wheel_;
   std::int64_t sweep_period_us_ = 100000;
   std::int64_t num_sweeps_ = 0, num_imu_ = 0;
   std::int64_t next_sweep_ = 0, next_imu_ = 0;
+  std::int64_t num_wheel_ = 0, next_wheel_ = 0;
+  std::int64_t wheelUtime(std::int64_t index) const;
 };
 
 // Points on the surfaces of a scene, about one per spacing^2 of area, from a fixed random stream.

@@ -41,14 +41,25 @@ bool SimSource::next(runtime::OutgoingMessage& out) {
   sim::SimEvent event;
   for (;;) {  // skip what a stalled stream would not have published
     if (!simulator_.next(event)) return false;
-    const bool scan = event.kind == sim::SimEvent::Kind::Scan;
-    const std::int64_t utime = scan ? event.scan.utime : event.imu.utime;
+    const bool scan = event.kind == sim::SimEvent::Kind::Scan, imu = event.kind == sim::SimEvent::Kind::Imu;
+    const std::int64_t utime = scan ? event.scan.utime : imu ? event.imu.utime : event.wheel.utime;
     if (first_utime_ < 0) first_utime_ = utime;
     if (scan) ++sweeps_;
     const double t_s = static_cast<double>(utime - first_utime_) * 1e-6;
-    if (!scan && channels_.imu.empty()) continue;
+    if (event.kind == sim::SimEvent::Kind::Wheel) {
+      if (channels_.wheel_odom.empty()) continue;
+      break;
+    }
+    if (imu && channels_.imu.empty()) continue;
     if (!(scan ? stalls_.lidar : stalls_.imu).covers(t_s)) break;
-    if (!scan) ++imu_seq_;
+    if (imu) ++imu_seq_;
+  }
+  if (event.kind == sim::SimEvent::Kind::Wheel) {
+    adit::wheel_odom_t m = msg::toMessage(event.wheel);
+    m.header.seq = wheel_seq_++;
+    out = {channels_.wheel_odom, msg::encode(m), event.wheel.utime};
+    ++health_.outputs;
+    return true;
   }
   if (event.kind == sim::SimEvent::Kind::Scan) {
     for (const auto& observe : sweep_observers_) observe(event.scan);

@@ -17,6 +17,7 @@ struct SimChannels {
   std::string lidar = "LIDAR_POINTS";
   std::string imu = "IMU";                    // "" = no IMU (a vehicle without one)
   std::string ground_truth = "GROUND_TRUTH";  // "" = do not publish
+  std::string wheel_odom = "WHEEL_ODOM";      // published when the simulation has wheel odometry (sim.wheel.enabled)
   // false: sweeps as full-float point_cloud_t, the format of logs before lidar_scan_t (tests of old logs).
   bool compact_sweeps = true;
 };
@@ -34,7 +35,8 @@ struct SimStalls {
 // The simulated head's firing table (ring of slot k fires k * firing_slot after its column), for encodeSweep.
 msg::FiringTable firingTableOf(const sim::LidarProfile& profile);
 
-// LIDAR_POINTS as compact lidar_scan_t (firing-grid layout), IMU, GROUND_TRUTH (odometry_t, pose only).
+// LIDAR_POINTS as compact lidar_scan_t (firing-grid layout), IMU, WHEEL_ODOM (when simulated), GROUND_TRUTH
+// (odometry_t, pose only).
 class SimSource : public runtime::MessageSource {
  public:
   SimSource(const sim::SimConfig& config, SimChannels channels, SimStalls stalls = {});
@@ -60,7 +62,7 @@ class SimSource : public runtime::MessageSource {
   runtime::Health health_;
   Trajectory truth_;
   std::optional<runtime::OutgoingMessage> pending_truth_;  // published right after its sweep
-  std::int64_t imu_seq_ = 0, truth_seq_ = 0;
+  std::int64_t imu_seq_ = 0, truth_seq_ = 0, wheel_seq_ = 0;
   std::vector<std::function<void(const LidarScan&)>> sweep_observers_;
   std::vector<std::function<void(const ImuSample&)>> imu_observers_;
 };

@@ -20,7 +20,7 @@ struct SimArgs {
   double duration_s = -1, rate = 1.0, world_spacing = 0.1, start_speed = -1, start_distance = -1;
   bool reverse = false, stationary = false;
   std::int64_t seed = -1;
-  bool live = false, no_truth_channel = false, no_imu = false;
+  bool live = false, no_truth_channel = false, no_imu = false, wheel_odom = false;
   std::string stall_lidar, stall_imu;
 };
 
@@ -78,7 +78,7 @@ void registerSimCommand(CLI::App& app) {
   cmd->add_option("--sensor", a->sensor, "vlp16 | rs16 | hdl64 (default vlp16)")->check(CLI::IsMember({"vlp16", "rs16", "hdl64"}));
   cmd->add_option("--duration", a->duration_s, "Simulated seconds (default 60)")->check(CLI::PositiveNumber);
   cmd->add_option("--seed", a->seed, "Seed of the world, the motion and every noise (default 1)")->check(CLI::NonNegativeNumber);
-  cmd->add_option("-o,--output", a->output, "LCM log to write (LIDAR_POINTS, IMU, GROUND_TRUTH)");
+  cmd->add_option("-o,--output", a->output, "LCM log to write (LIDAR_POINTS, IMU, GROUND_TRUTH; WHEEL_ODOM with --wheel-odom)");
   cmd->add_option("--gt", a->gt, "Ground truth as TUM: T_world_lidar at each sweep's utime (its last firing)");
   cmd->add_option("--world-pcd", a->world_pcd, "Also write the world's surfaces as a PCD (for comparing with the map)");
   cmd->add_option("--pcap", a->pcap, "Also write the lidar as the VLP-16 packet capture a real sensor would give "
@@ -104,6 +104,8 @@ void registerSimCommand(CLI::App& app) {
                 "The robot stands still at the route's start for the whole run (sim.motion.stationary; "
                 "sim.motion.idle_vibration: chassis vibration at rest)");
   cmd->add_flag("--no-imu", a->no_imu, "Publish no IMU (a vehicle without one)");
+  cmd->add_flag("--wheel-odom", a->wheel_odom,
+                "Also publish WHEEL_ODOM: track odometry with 3-8 % slip and noise (sim.wheel.enabled; sim.wheel.*)");
   cmd->add_option("--stall-lidar", a->stall_lidar,
                   "Fault test: publish no LIDAR_POINTS (nor their GROUND_TRUTH) from START for SECONDS of sensor "
                   "time (START:SECONDS)");
@@ -116,6 +118,7 @@ void registerSimCommand(CLI::App& app) {
     if (!a->world.empty()) file.set("sim.world", a->world);
     if (!a->sensor.empty()) file.set("sim.sensor", a->sensor);
     if (a->seed >= 0) file.set("sim.seed", std::to_string(a->seed));
+    if (a->wheel_odom) file.set("sim.wheel.enabled", "true");
     adit::sim::SimConfig config = adit::sim::simConfigFrom(file);
     if (a->duration_s > 0) config.duration_s = a->duration_s;
     if (a->start_speed >= 0) config.motion.start_speed = a->start_speed;

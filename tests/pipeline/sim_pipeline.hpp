@@ -16,6 +16,7 @@
 #include <cmath>
 #include <filesystem>
 #include <functional>
+#include <map>
 #include <string>
 
 namespace adit::test {
@@ -23,6 +24,7 @@ namespace adit::test {
 struct SimPipelineRun {
   Trajectory ground_truth, odometry, corrected;
   Trajectory scan_odometry;  // ODOM_SCAN: scan-to-scan odometry alone (SimPipelineSetup::scan_odometry)
+  std::map<std::string, std::int64_t> odometry_counters;  // the odometry stage's STATUS counters at the end
   std::vector<LoopConstraint> loops;
   int false_loops = 0;
   double worst_loop_error_m = 0, worst_loop_error_deg = 0;
@@ -37,14 +39,16 @@ struct SimPipelineSetup {
   std::function<void(sim::SimConfig&)> adjust;  // e.g. motion.start_speed
   bool imu = true;                              // false: the simulator publishes no IMU
   bool scan_odometry = false;                   // also collect ODOM_SCAN's poses (SimPipelineRun::scan_odometry)
+  std::function<void(Config&)> configure;       // pipeline keys beyond launch/config + launch/sensors/sim.yaml
 };
 
 inline SimPipelineRun runSimPipeline(const std::string& world, double duration_s, std::uint64_t seed,
                                      const SimPipelineSetup& setup = {}) {
   namespace fs = std::filesystem;
   const fs::path launch = fs::path(ADIT_SOURCE_DIR) / "launch";
-  const Config config = runtime::loadConfig(
+  Config config = runtime::loadConfig(
       {(launch / "config" / "pipeline.yaml").string(), (launch / "sensors" / "sim.yaml").string()});
+  if (setup.configure) setup.configure(config);
   sim::SimConfig sim = sim::simConfigFrom(config, world, seed);
   sim.duration_s = duration_s;
   if (setup.adjust) setup.adjust(sim);
@@ -61,9 +65,11 @@ inline SimPipelineRun runSimPipeline(const std::string& world, double duration_s
   options.config = config;
   options.record = "^LOOP_CLOSURE$";
   if (setup.scan_odometry) options.record_poses = "^ODOM_SCAN$";
-  pipeline::runReplay(options);
+  const pipeline::ReplayReport report = pipeline::runReplay(options);
 
   SimPipelineRun run;
+  for (const auto& stage : report.timing)
+    if (stage.stage == "odometry") run.odometry_counters = stage.counters;
   run.ground_truth = source.groundTruth();
   run.odometry = eval::readTum(options.out_dir + "/odometry.tum");
   run.corrected = eval::readTum(options.out_dir + "/trajectory.tum");
