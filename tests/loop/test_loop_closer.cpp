@@ -284,7 +284,7 @@ TEST(LoopCloser, PartialLoopsCorrectTheCrossSectionOfAFeaturelessRoadway) {
 
   LoopCloserConfig off = testConfig();
   off.partial_loops = false;
-  Drive refused{LoopCloser(off)};
+  Drive refused{LoopCloser(off), 0, {}};
   drive(refused, world, truth, mapped);
   EXPECT_EQ(refused.closer.stats().accepted, 0);
   EXPECT_GT(refused.closer.stats().rejected_degenerate, 0);
