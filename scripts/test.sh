@@ -16,7 +16,10 @@ fi
 shift
 bash scripts/setup.sh --no-build
 BUILD=build-sanitize
-SAN="-fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined"
+# -fno-sanitize=vptr: gcc's vptr check breaks LCM 1.3.1's own C++ subscription callbacks (lcm-cpp-impl.hpp:
+# cb_func): a ten-line program that only subscribes through lcm::LCM reports "invalid vptr" there and then
+# crashes, and runs clean under every other check; with it, every test that starts a stage process failed.
+SAN="-fsanitize=address,undefined -fno-sanitize=vptr -fno-omit-frame-pointer -fno-sanitize-recover=undefined"
 if [[ ! -f $BUILD/CMakeCache.txt ]]; then
   cmake -S . -B "$BUILD" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DADIT_STRICT=ON \
     -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g" -DCMAKE_C_FLAGS_RELWITHDEBINFO="-O1 -g" \
