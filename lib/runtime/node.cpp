@@ -109,7 +109,8 @@ bool Node::continuesStream(const Input& input, std::int64_t utime) const {
     const std::int64_t period = input.typicalStep();
     if (period > 0 && static_cast<double>(utime - input.last_utime) > checks_.max_step_periods * period) return false;
   }
-  return newest_utime_ < 0 || utime <= newest_utime_ + tolerance;
+  // Written so that no utime, however corrupt, overflows the arithmetic (newest_utime_ >= 0 past the first test).
+  return newest_utime_ < 0 || utime <= newest_utime_ || utime - newest_utime_ <= tolerance;
 }
 
 void Node::dropHeld(Input& input) {
@@ -139,8 +140,11 @@ void Node::admit(Input& input, Held message) {
   }
   // Off the stream's time: hold it; a new stream needs confirm_messages consistent successors.
   const auto tolerance = static_cast<std::int64_t>(checks_.max_future_s * 1e6);
+  // The difference of two corrupt utimes can exceed int64 (INT64_MIN then a real time): taken unsigned, it is
+  // exact because the first is the larger.
   const bool chained = !input.held.empty() && message.utime > input.held.back().utime &&
-                       message.utime - input.held.back().utime <= tolerance;
+                       static_cast<std::uint64_t>(message.utime) - static_cast<std::uint64_t>(input.held.back().utime) <=
+                           static_cast<std::uint64_t>(tolerance);
   if (!chained) dropHeld(input);
   input.held.push_back(std::move(message));
   if (static_cast<int>(input.held.size()) <= checks_.confirm_messages) return;

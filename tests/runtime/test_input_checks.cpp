@@ -227,3 +227,23 @@ TEST(Messages, WheelOdometryRoundTrip) {
   EXPECT_EQ(out.yaw_rate_sigma, 0.01);
   EXPECT_EQ(back.header.frame_id, "base");
 }
+
+// Found by the sanitized suite (UBSan, signed overflow): the time checks subtracted and added corrupt stamps
+// as int64. A stamp of INT64_MIN held as off-stream, then a forged one far ahead: their difference overflowed.
+TEST(InputChecks, ExtremeStampsNeverOverflowTheTimeChecks) {
+  ImuNode node;
+  for (int i = 1; i <= 5; ++i) send(node, imu(i * 5 * kMs));
+  send(node, imu(std::numeric_limits<std::int64_t>::min()));
+  send(node, imu(1000 * kS));
+  for (int i = 6; i <= 10; ++i) send(node, imu(i * 5 * kMs));
+  EXPECT_EQ(node.utimes.size(), 10u);
+  EXPECT_EQ(node.utimes.back(), 50 * kMs);
+  EXPECT_EQ(node.jumps, 0);
+
+  // A clock that restarts just below INT64_MAX is followed once confirmed, and its steps continue the stream
+  // (the future limit added to the newest stamp used to wrap negative and turn every step away).
+  const std::int64_t top = std::numeric_limits<std::int64_t>::max() - kS;
+  for (int i = 0; i < 20; ++i) send(node, imu(top + i * 5 * kMs));
+  EXPECT_EQ(node.utimes.back(), top + 19 * 5 * kMs);
+  EXPECT_GE(node.utimes.size(), 10u + 15u);
+}
