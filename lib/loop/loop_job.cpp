@@ -55,7 +55,8 @@ class JobRun {
         scanContextSeed(job_.query_uncorrected, c.match_uncorrected, c.candidate.yaw, config_.level_scan_context),
         T_graph};
     const LoopVerification v = verifyCandidate(job_.query_cloud, c.neighbourhood, seeds, config_.verifier);
-    const bool partial = v.verdict == LoopVerdict::kDegenerate && freeAlongOneAxisOnly(v.icp);
+    const bool partial = v.verdict == LoopVerdict::kDegenerate && config_.partial_loops &&
+                         pinsAllButOneTranslation(v.icp.observability, config_.verifier);
     if (v.verdict == LoopVerdict::kDegenerate && !partial) {
       ++counts_.rejected_degenerate;
       return std::nullopt;
@@ -95,13 +96,6 @@ class JobRun {
     loop.fitness = v.icp.rms;
     loop.inlier_ratio = v.icp.inlier_ratio;
     return loop;
-  }
-
-  // A degenerate fit that still pins both other translations and every rotation.
-  bool freeAlongOneAxisOnly(const IcpResult& fit) const {
-    const FitObservability& pinned = fit.observability;
-    return config_.partial_loops && pinned.middleTranslationRatio() >= config_.verifier.min_eigenvalue_ratio &&
-           pinned.rotation_sigma_rad <= config_.verifier.max_rotation_sigma;
   }
 
   bool pairConsistent(const LoopConstraint& a, const LoopConstraint& b) const {

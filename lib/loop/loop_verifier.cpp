@@ -20,6 +20,14 @@ bool fitsTightly(const IcpResult& r, const LoopVerifierConfig& config) {
   return r.rms <= config.max_rms && r.inlier_ratio >= config.min_inlier_ratio;
 }
 
+bool pinsEveryDirection(const FitObservability& fit, const LoopVerifierConfig& config) {
+  return fit.weakestTranslationRatio() >= config.min_eigenvalue_ratio && fit.rotation_sigma_rad <= config.max_rotation_sigma;
+}
+
+bool pinsAllButOneTranslation(const FitObservability& fit, const LoopVerifierConfig& config) {
+  return fit.middleTranslationRatio() >= config.min_eigenvalue_ratio && fit.rotation_sigma_rad <= config.max_rotation_sigma;
+}
+
 std::vector<Eigen::Vector3f> querySource(const std::vector<Eigen::Vector3f>& query_cloud, const LoopVerifierConfig& config) {
   return voxelDownsample(query_cloud, config.query_voxel);
 }
@@ -48,8 +56,7 @@ LoopVerification verifyLoopAgainst(const PlaneTarget& target, const std::vector<
     if (fitsTightly(r, config)) break;
   }
   if (!fitsTightly(out.icp, config)) return out;
-  const FitObservability& pinned = out.icp.observability;
-  if (pinned.weakestTranslationRatio() < config.min_eigenvalue_ratio || pinned.rotation_sigma_rad > config.max_rotation_sigma)
+  if (!pinsEveryDirection(out.icp.observability, config))
     out.verdict = LoopVerdict::kDegenerate;
   else if (out.icp.converged)
     out.verdict = LoopVerdict::kAccepted;

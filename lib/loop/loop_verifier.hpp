@@ -63,6 +63,11 @@ std::vector<Eigen::Vector3f> querySource(const std::vector<Eigen::Vector3f>& que
 
 // A tight fit (inlier RMS and ratio), converged or not.
 bool fitsTightly(const IcpResult& result, const LoopVerifierConfig& config);
+// The fit pins every direction (min_eigenvalue_ratio, max_rotation_sigma); else it is degenerate.
+bool pinsEveryDirection(const FitObservability& fit, const LoopVerifierConfig& config);
+// The fit pins two translations and every rotation: at most its weakest translation is free (the axis of a
+// straight roadway, which a partial loop leaves to the odometry and the relocaliser searches along).
+bool pinsAllButOneTranslation(const FitObservability& fit, const LoopVerifierConfig& config);
 
 const char* toString(LoopVerdict verdict);
 

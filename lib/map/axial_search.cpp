@@ -10,10 +10,8 @@ namespace {
 // The translation along which the fit is weakest (left perturbation: in the target frame); zero when a second
 // translation is weak too or a rotation is (FitObservability, with the loop verifier's thresholds).
 Eigen::Vector3d weakTranslation(const IcpResult& fit, const LoopVerifierConfig& verifier) {
-  const FitObservability& pinned = fit.observability;
-  if (pinned.middleTranslationRatio() < verifier.min_eigenvalue_ratio || pinned.rotation_sigma_rad > verifier.max_rotation_sigma)
-    return Eigen::Vector3d::Zero();
-  return pinned.weakestTranslation().normalized();
+  if (!pinsAllButOneTranslation(fit.observability, verifier)) return Eigen::Vector3d::Zero();
+  return fit.observability.weakestTranslation().normalized();
 }
 
 struct Place {
