@@ -2,6 +2,7 @@
 
 #include "mapping/downsample.hpp"
 #include "registration/feature_fit.hpp"
+#include "registration/match_reuse.hpp"
 #include "odometry/motion_compensation.hpp"
 #include "registration/parallel_matching.hpp"
 #include "registration/pose_increment.hpp"
@@ -31,6 +32,7 @@ MapperConfig aloamMapperConfig() {
   m.registration.degeneracy_prior = false;
   m.compensate_raw_sweeps = false;
   m.registration.max_solver_iterations = 4;
+  m.registration.reuse_match_distance_m = 0.0;  // A-LOAM searches every round afresh
   m.plane_through_nearest = false;
   return m;
 }
@@ -74,23 +76,35 @@ ScanToMapMapper::ScanToMapMapper(MapperConfig config)
                                                     : nullptr) {}
 
 Correspondences ScanToMapMapper::match(const std::vector<Eigen::Vector3d>& corners,
-                                       const std::vector<Eigen::Vector3d>& surfs, const Eigen::Isometry3d& T) const {
+                                       const std::vector<Eigen::Vector3d>& surfs, const Eigen::Isometry3d& T,
+                                       MatchReuse* reuse) const {
   const int k = std::max(3, config_.neighbours);
   const auto add_line = [&](std::size_t i, std::vector<LineMatch>& lines) {
-    thread_local std::vector<Eigen::Vector3d> near;
-    corner_map_.nearest(T * corners[i], k, config_.max_neighbour_distance_m, near);
-    if (static_cast<int>(near.size()) < k) return;
-    if (const auto line = fitLine(near, config_.line_eigen_ratio)) lines.push_back({corners[i], line->centroid, line->direction});
+    const auto search = [&](const Eigen::Vector3d& q) -> std::optional<LineMatch> {
+      thread_local std::vector<Eigen::Vector3d> near;
+      corner_map_.nearest(q, k, config_.max_neighbour_distance_m, near);
+      if (static_cast<int>(near.size()) < k) return std::nullopt;
+      if (const auto line = fitLine(near, config_.line_eigen_ratio)) return LineMatch{corners[i], line->centroid, line->direction};
+      return std::nullopt;
+    };
+    const Eigen::Vector3d q = T * corners[i];
+    if (reuse) reuse->line(i, q, lines, search);
+    else if (const auto m = search(q)) lines.push_back(*m);
   };
   const auto add_plane = [&](std::size_t i, std::vector<PlaneMatch>& planes) {
-    thread_local std::vector<Eigen::Vector3d> near;
-    surf_map_.nearest(T * surfs[i], k, config_.max_neighbour_distance_m, near);
-    if (static_cast<int>(near.size()) < k) return;
-    const auto plane = fitPlane(near, config_.plane_max_point_distance_m);
-    if (!plane) return;
-    // VoxelMap::nearest lists the neighbours nearest first.
-    const double offset = config_.plane_through_nearest ? -plane->normal.dot(near.front()) : plane->offset;
-    planes.push_back({surfs[i], plane->normal, offset});
+    const auto search = [&](const Eigen::Vector3d& q) -> std::optional<PlaneMatch> {
+      thread_local std::vector<Eigen::Vector3d> near;
+      surf_map_.nearest(q, k, config_.max_neighbour_distance_m, near);
+      if (static_cast<int>(near.size()) < k) return std::nullopt;
+      const auto plane = fitPlane(near, config_.plane_max_point_distance_m);
+      if (!plane) return std::nullopt;
+      // VoxelMap::nearest lists the neighbours nearest first.
+      const double offset = config_.plane_through_nearest ? -plane->normal.dot(near.front()) : plane->offset;
+      return PlaneMatch{surfs[i], plane->normal, offset};
+    };
+    const Eigen::Vector3d q = T * surfs[i];
+    if (reuse) reuse->plane(i, q, planes, search);
+    else if (const auto m = search(q)) planes.push_back(*m);
   };
   return matchInChunks(pool_.get(), corners.size(), surfs.size(), add_line, add_plane);
 }
@@ -133,8 +147,9 @@ ScanToMapMapper::Refinement ScanToMapMapper::refine(const Sweep& sweep, const Ei
                                                      int& iterations) const {
   Refinement out;
   out.pose = predicted;
+  MatchReuse reuse(sweep.corner_points.size(), sweep.surf_points.size(), config_.registration.reuse_match_distance_m);
   for (int round = 0; round < std::max(1, config_.outer_iterations); ++round) {
-    out.result = registerStep(match(sweep.corner_points, sweep.surf_points, out.pose), out.pose, predicted,
+    out.result = registerStep(match(sweep.corner_points, sweep.surf_points, out.pose, &reuse), out.pose, predicted,
                               config_.registration);
     iterations += out.result.iterations;
     if (!(out.ok = out.result.ok)) break;

@@ -16,6 +16,8 @@
 
 namespace adit {
 
+class MatchReuse;  // registration/match_reuse.hpp
+
 class ChunkPool;  // registration/chunk_pool.hpp
 
 struct MapperConfig {
@@ -106,8 +108,9 @@ class ScanToMapMapper {
   const Eigen::Isometry3d& mapFromOdometry() const { return T_map_odom_; }
 
  private:
+  // reuse: keep a query's match from an earlier round of the same sweep while it barely moves.
   Correspondences match(const std::vector<Eigen::Vector3d>& corners, const std::vector<Eigen::Vector3d>& surfs,
-                        const Eigen::Isometry3d& T_world_lidar) const;
+                        const Eigen::Isometry3d& T_world_lidar, MatchReuse* reuse) const;
   struct Sweep {  // what the maps take from a FeatureSet
     std::int64_t utime = 0;
     bool raw = false;

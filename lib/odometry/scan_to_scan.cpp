@@ -1,6 +1,7 @@
 #include "odometry/scan_to_scan.hpp"
 
 #include "registration/feature_fit.hpp"
+#include "registration/match_reuse.hpp"
 #include "core/wheel_odom.hpp"
 #include "odometry/motion_compensation.hpp"
 #include "odometry/startup_search.hpp"
@@ -36,6 +37,7 @@ ScanToScanConfig aloamOdometryConfig() {
   s.compensate_mixed_deskew = false;
   s.outer_iterations = 2;
   s.registration.max_solver_iterations = 4;
+  s.registration.reuse_match_distance_m = 0.0;  // A-LOAM searches every round afresh
   s.max_match_distance_m = 5.0;
   s.startup_max_speed_mps = 0.0;
   return s;
@@ -224,18 +226,28 @@ std::optional<PlaneFit> ScanToScanOdometry::fitLocalPlane(const Eigen::Vector3d&
 }
 
 Correspondences ScanToScanOdometry::match(const std::vector<LidarPoint>& sharp, const std::vector<LidarPoint>& flat,
-                                          const Eigen::Isometry3d& T) const {
+                                          const Eigen::Isometry3d& T, MatchReuse* reuse) const {
   awaitPrevious();
   const double max_sq = config_.max_match_distance_m * config_.max_match_distance_m;
   const auto add_line = [&](std::size_t i, std::vector<LineMatch>& lines) {
     if (!sharp[i].p.allFinite()) return;
     const Eigen::Vector3d p = sharp[i].p.cast<double>(), q = T * p;
-    if (const auto line = fitLocalLine(q, max_sq)) lines.push_back({p, line->centroid, line->direction});
+    const auto search = [&](const Eigen::Vector3d& at) -> std::optional<LineMatch> {
+      if (const auto line = fitLocalLine(at, max_sq)) return LineMatch{p, line->centroid, line->direction};
+      return std::nullopt;
+    };
+    if (reuse) reuse->line(i, q, lines, search);
+    else if (const auto m = search(q)) lines.push_back(*m);
   };
   const auto add_plane = [&](std::size_t i, std::vector<PlaneMatch>& planes) {
     if (!flat[i].p.allFinite()) return;
     const Eigen::Vector3d p = flat[i].p.cast<double>(), q = T * p;
-    if (const auto plane = fitLocalPlane(q, max_sq)) planes.push_back({p, plane->normal, plane->offset});
+    const auto search = [&](const Eigen::Vector3d& at) -> std::optional<PlaneMatch> {
+      if (const auto plane = fitLocalPlane(at, max_sq)) return PlaneMatch{p, plane->normal, plane->offset};
+      return std::nullopt;
+    };
+    if (reuse) reuse->plane(i, q, planes, search);
+    else if (const auto m = search(q)) planes.push_back(*m);
   };
   return matchInChunks(pool_.get(), sharp.size(), flat.size(), add_line, add_plane);
 }
@@ -247,8 +259,9 @@ ScanToScanOdometry::Refinement ScanToScanOdometry::refine(const SweepPoints& cur
   Refinement out;
   out.pose = seed;
   out.ok = true;
+  MatchReuse reuse(cur.sharp.size(), cur.flat.size(), config_.registration.reuse_match_distance_m);
   for (int round = 0; round < std::max(1, config_.outer_iterations); ++round) {
-    out.result = registerStep(match(cur.sharp, cur.flat, out.pose), out.pose, hold, registration);
+    out.result = registerStep(match(cur.sharp, cur.flat, out.pose, &reuse), out.pose, hold, registration);
     out.iterations += out.result.iterations;
     if (!(out.ok = out.result.ok)) break;
     const bool converged = hasConverged(out.pose, out.result.pose);

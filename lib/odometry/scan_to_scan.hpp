@@ -18,6 +18,8 @@
 
 namespace adit {
 
+class MatchReuse;  // registration/match_reuse.hpp
+
 class ChunkPool;  // registration/chunk_pool.hpp
 
 struct ScanToScanConfig {
@@ -138,9 +140,10 @@ class ScanToScanOdometry {
   bool hasVelocity(std::int64_t utime) const;
 
   // The correspondences of sharp / flat points against the previous sweep at a guess of T_prev_curr
-  // (what one registration round uses; public for diagnostics and tests).
+  // (what one registration round uses; public for diagnostics and tests). With `reuse`, a query that barely
+  // moved since an earlier round of the same registration keeps that round's match (match_reuse.hpp).
   Correspondences match(const std::vector<LidarPoint>& sharp, const std::vector<LidarPoint>& flat,
-                        const Eigen::Isometry3d& T_prev_curr) const;
+                        const Eigen::Isometry3d& T_prev_curr, MatchReuse* reuse = nullptr) const;
 
   const Eigen::Isometry3d& pose() const { return pose_; }
   // The velocity (tangent, per second) of the last step (zero before two sweeps) and the time of the last

@@ -179,7 +179,8 @@ ConfigTable<RegistrationConfig> registrationConfigTable(const std::string& prefi
    .add("degeneracy_remap", &G::degeneracy_remap, anyValue(), "", "set the solution along degenerate directions to the prior's (Zhang 2016)")
    .add("prior_sigma_translation_m", &G::prior_sigma_translation_m, above(0), "m", "motion-model uncertainty per sweep (covariance of degenerate directions)")
    .add("prior_sigma_rotation_rad", &G::prior_sigma_rotation_rad, above(0), "rad", "same for rotation")
-   .add("search_threads", &G::search_threads, between(1, 64), "threads", "threads of the correspondence search (same result for any count)");
+   .add("search_threads", &G::search_threads, between(1, 64), "threads", "threads of the correspondence search (same result for any count)")
+   .add("reuse_match_distance_m", &G::reuse_match_distance_m, atLeast(0), "m", "a query that moved less than this since its last search in the sweep keeps that match (0: search every round)");
   return t;
 }
 

@@ -59,6 +59,9 @@ struct RegistrationConfig {
   // Threads of the correspondence search (a fixed partition of the queries, chunk_pool.hpp): the result is
   // the same bytes for any count; 2 halves the search's wall time on a 2-core machine.
   int search_threads = 2;
+  // A query that moved less than this since its last search in the same registration keeps that search's
+  // match (match_reuse.hpp): later rounds re-search only what moved. 0 re-searches every query every round.
+  double reuse_match_distance_m = 0.02;
 };
 
 // Keys "<prefix>.max_solver_iterations", "<prefix>.loss", ... (prefix "odometry" or "mapping").

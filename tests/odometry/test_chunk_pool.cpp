@@ -1,9 +1,10 @@
-// The parallel correspondence search (registration/chunk_pool.*, parallel_matching.hpp): every query is
-// searched once, an error in a chunk reaches the caller, and odometry and mapping give the same bytes with
-// one thread or several.
+// The correspondence search (registration/chunk_pool.*, parallel_matching.hpp, match_reuse.hpp): every query
+// is searched once, an error in a chunk reaches the caller, odometry and mapping give the same bytes with one
+// thread or several, and a match is kept across rounds exactly while its query stays within the tolerance.
 #include "mapping/scan_to_map.hpp"
 #include "odometry/scan_to_scan.hpp"
 #include "registration/chunk_pool.hpp"
+#include "registration/match_reuse.hpp"
 #include "registration/parallel_matching.hpp"
 #include "synthetic_world.hpp"
 
@@ -11,6 +12,8 @@
 
 #include <atomic>
 #include <cstring>
+#include <limits>
+#include <optional>
 #include <stdexcept>
 
 namespace adit {
@@ -70,13 +73,72 @@ TEST(ParallelMatching, JoinsChunksInQueryOrder) {
   for (std::size_t i = 0; i < serial.planes.size(); ++i) EXPECT_EQ(parallel.planes[i].point, serial.planes[i].point);
 }
 
+TEST(MatchReuse, KeepsAMatchWhileItsQueryStaysWithinTheTolerance) {
+  MatchReuse reuse(1, 1, 0.02);
+  int searches = 0;
+  // The plane found depends on where the query was searched: its offset records that position's x.
+  const auto search = [&](const Eigen::Vector3d& q) -> std::optional<PlaneMatch> {
+    ++searches;
+    return PlaneMatch{Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitX(), -q.x()};
+  };
+  std::vector<PlaneMatch> out;
+  reuse.plane(0, Eigen::Vector3d(1, 0, 0), out, search);
+  reuse.plane(0, Eigen::Vector3d(1.019, 0, 0), out, search);  // moved 19 mm: kept
+  reuse.plane(0, Eigen::Vector3d(1.0, 0.015, 0.0), out, search);  // measured from where it was searched: kept
+  reuse.plane(0, Eigen::Vector3d(1.021, 0, 0), out, search);  // 21 mm: searched again
+  reuse.plane(0, Eigen::Vector3d(1.03, 0, 0), out, search);   // 9 mm from the new search: kept
+  ASSERT_EQ(out.size(), 5u);
+  EXPECT_EQ(searches, 2);
+  EXPECT_EQ(out[0].offset, -1.0);
+  EXPECT_EQ(out[1].offset, -1.0);
+  EXPECT_EQ(out[2].offset, -1.0);
+  EXPECT_EQ(out[3].offset, -1.021);
+  EXPECT_EQ(out[4].offset, -1.021);
+  EXPECT_EQ(reuse.searched(), 2u);
+  EXPECT_EQ(reuse.reused(), 3u);
+}
+
+TEST(MatchReuse, RemembersThatAQueryFoundNothingAndKeepsQueriesApart) {
+  MatchReuse reuse(2, 0, 0.05);
+  int searches = 0;
+  const auto none = [&](const Eigen::Vector3d&) -> std::optional<LineMatch> { ++searches; return std::nullopt; };
+  const auto found = [&](const Eigen::Vector3d& q) -> std::optional<LineMatch> {
+    ++searches;
+    return LineMatch{q, q, Eigen::Vector3d::UnitZ()};
+  };
+  std::vector<LineMatch> out;
+  reuse.line(0, Eigen::Vector3d::Zero(), out, none);
+  reuse.line(1, Eigen::Vector3d::Zero(), out, found);  // another query at the same place: its own search
+  reuse.line(0, Eigen::Vector3d(0.01, 0, 0), out, found);  // still "nothing": not searched again
+  EXPECT_EQ(searches, 2);
+  ASSERT_EQ(out.size(), 1u);
+  reuse.line(0, Eigen::Vector3d(0.06, 0, 0), out, found);  // moved away: searched, and now it matches
+  EXPECT_EQ(searches, 3);
+  EXPECT_EQ(out.size(), 2u);
+}
+
+TEST(MatchReuse, ZeroToleranceSearchesEveryTimeAndNonFiniteQueriesAreSearched) {
+  MatchReuse reuse(0, 1, 0.0);
+  int searches = 0;
+  const auto search = [&](const Eigen::Vector3d&) -> std::optional<PlaneMatch> { ++searches; return std::nullopt; };
+  std::vector<PlaneMatch> out;
+  for (int i = 0; i < 3; ++i) reuse.plane(0, Eigen::Vector3d(1, 2, 3), out, search);
+  EXPECT_EQ(searches, 3);
+  MatchReuse nan(0, 1, 1.0);
+  const Eigen::Vector3d bad = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
+  for (int i = 0; i < 2; ++i) nan.plane(0, bad, out, search);
+  EXPECT_EQ(searches, 5) << "a NaN position is never 'within the tolerance'";
+}
+
 // A short drive through the box room, odometry then mapping, with `threads` search threads.
-std::pair<PoseEstimate, PoseEstimate> drive(int threads) {
+std::pair<PoseEstimate, PoseEstimate> drive(int threads, double reuse_m = 0.02) {
   const auto world = test::boxRoom();
   ScanToScanConfig oc;
   oc.registration.search_threads = threads;
+  oc.registration.reuse_match_distance_m = reuse_m;
   MapperConfig mc;
   mc.registration.search_threads = threads;
+  mc.registration.reuse_match_distance_m = reuse_m;
   ScanToScanOdometry odom(oc);
   ScanToMapMapper mapper(mc);
   const Eigen::Isometry3d motion = test::poseFrom(0.3, -0.1, 0.02, 0.01, -0.005, 0.04);
@@ -103,6 +165,17 @@ TEST(ParallelMatching, OdometryAndMappingGiveTheSameBytesForAnyThreadCount) {
     const auto many = drive(threads);
     EXPECT_TRUE(sameBytes(one.first, many.first)) << threads << " threads, odometry";
     EXPECT_TRUE(sameBytes(one.second, many.second)) << threads << " threads, mapping";
+  }
+}
+
+TEST(MatchReuse, OdometryAndMappingLandWhereSearchingEveryRoundLands) {
+  // The pose of the last sweep, with matches kept across rounds and with every round searched afresh:
+  // the same to well under the 0.05 m point noise of the synthetic sweeps.
+  const auto kept = drive(1, 0.02), fresh = drive(1, 0.0);
+  for (const auto& [a, b] : {std::make_pair(kept.first, fresh.first), std::make_pair(kept.second, fresh.second)}) {
+    EXPECT_EQ(a.flags & PoseEstimate::kRegistrationFailed, 0);
+    EXPECT_LT((a.pose.translation() - b.pose.translation()).norm(), 0.005);
+    EXPECT_LT(Eigen::AngleAxisd(a.pose.linear().transpose() * b.pose.linear()).angle(), 0.001);
   }
 }
 
