@@ -32,6 +32,10 @@ const ConfigTable<RelocaliserConfig>& relocaliserConfigTable() {
      .add("max_track_correction", &R::max_track_correction, above(0), "m", "a tracking fit moving the pose more than this is refused")
      .add("max_track_failures", &R::max_track_failures, between(1, 100000), "", "failed tracking verifications in a row that make the run lost")
      .add("max_stall_s", &R::max_stall_s, above(0), "s", "a gap in the input longer than this makes the run lost")
+     .add("refuse_self_similar", &R::refuse_self_similar, anyValue(), "", "refuse a fix where the map's own keyframe also fits tightly at another mapped place")
+     .add("self_similar_candidates", &R::self_similar_candidates, between(1, 10000), "", "Scan Context candidates ranked when looking for that other place")
+     .add("self_similar_samples", &R::self_similar_samples, between(1, 1000), "keyframes", "keyframes spread over the map checked to judge whether the whole map repeats itself")
+     .add("self_similar_map_ratio", &R::self_similar_map_ratio, between(0, 1), "", "share of them that must repeat for every fix in the map to be refused")
      .nest(&R::axial, axialSearchConfigTable());
     return t;
   }();
@@ -43,8 +47,22 @@ const char* toString(RelocState state) {
 }
 
 Relocaliser::Relocaliser(MapBundle bundle, const LoopCloserConfig& loop, const RelocaliserConfig& config)
-    : bundle_(std::move(bundle)), loop_(loop), config_(config), database_(config.candidates) {
-  for (const BundleKeyframe& k : bundle_.keyframes) database_.add(k.context, k.utime);
+    : bundle_(std::move(bundle)),
+      loop_(loop),
+      config_(config),
+      database_(config.candidates),
+      alias_database_(config.self_similar_candidates),
+      self_similar_(bundle_.keyframes.size(), -1) {
+  for (const BundleKeyframe& k : bundle_.keyframes) {
+    database_.add(k.context, k.utime);
+    alias_database_.add(k.context, k.utime);
+  }
+  // The judgement reads only the bundle, the databases and the configuration, none of which change from here.
+  if (config_.refuse_self_similar) map_judgement_ = std::async(std::launch::async, [this] { return judgeMap(); });
+}
+
+Relocaliser::~Relocaliser() {
+  if (map_judgement_.valid()) map_judgement_.wait();
 }
 
 Relocaliser::Result Relocaliser::process(const PoseEstimate& session, const std::vector<Eigen::Vector3f>& cloud,
@@ -161,14 +179,14 @@ std::optional<Relocaliser::Fix> Relocaliser::query(const PoseEstimate& session, 
 // degeneracy test refuses nearly every single-sweep fit on a straight, and a fit it accepts can still be one of
 // several along a repeating roadway.
 LoopVerification Relocaliser::verify(const PlaneTarget& target, const std::vector<Eigen::Vector3f>& source,
-                                     const Eigen::Isometry3d& seed, AxialSearchResult& search) {
-  ++stats_.verified;
+                                     const Eigen::Isometry3d& seed, AxialSearchResult& search, RelocStats& stats) const {
+  ++stats.verified;
   LoopVerification v = verifyLoopAgainst(target, source, {seed}, loop_.verifier);
   const bool tight = v.verdict == LoopVerdict::kDegenerate || v.verdict == LoopVerdict::kAccepted;
   if (!tight || !config_.axial.enabled) return v;
-  ++stats_.axial_searches;
+  ++stats.axial_searches;
   search = searchWeakDirection(target, source, v.icp, loop_.verifier, config_.axial);
-  if (std::string(search.refusal) == "ambiguous") ++stats_.axial_ambiguous;
+  if (std::string(search.refusal) == "ambiguous") ++stats.axial_ambiguous;
   if (!search.resolved) {
     // Refused, but its line's best place is what another candidate's fit must beat (the ambiguity test).
     v.verdict = LoopVerdict::kDegenerate;
@@ -178,7 +196,7 @@ LoopVerification Relocaliser::verify(const PlaneTarget& target, const std::vecto
     }
     return v;
   }
-  ++stats_.axial_resolved;
+  ++stats.axial_resolved;
   v.verdict = LoopVerdict::kAccepted;
   v.icp = search.icp;
   v.T_match_query = search.T_target_source;
@@ -218,7 +236,8 @@ std::optional<Relocaliser::Fix> Relocaliser::bestFix(const PoseEstimate& session
     if (searched(tried, match.pose.translation())) continue;
     const std::unique_ptr<PlaneTarget> target = candidateTarget(neighbourhood(c.index), loop_.verifier);
     Tried t;
-    t.v = verify(*target, source, scanContextSeed(session.pose, match.pose, c.yaw, loop_.level_scan_context), t.search);
+    t.v = verify(*target, source, scanContextSeed(session.pose, match.pose, c.yaw, loop_.level_scan_context), t.search,
+                 stats_);
     t.fix = {c.index, t.v.T_match_query, session.pose, travelled_};
     tried.push_back(t);
   }
@@ -253,8 +272,99 @@ std::optional<Relocaliser::Fix> Relocaliser::bestFix(const PoseEstimate& session
       return std::nullopt;
     }
   }
+  if (config_.refuse_self_similar && (mapSelfSimilar() || selfSimilar(mapPose(best->fix)))) {
+    ++stats_.rejected_self_similar;
+    record.outcome = "self_similar";
+    return std::nullopt;
+  }
   record.outcome = "candidate";
   return best->fix;
+}
+
+// Whether the map repeats the place of a fix. The bundle keyframe nearest the fix is queried as a relocalising
+// query would be (its own Scan Context, its cloud verified by ICP with the search along the roadway), against
+// every candidate whose submap does not hold that keyframe itself; a tight fit that lands more than
+// reloc.ambiguity_distance away is an alias. The query's own ambiguity test cannot see this when the alias the
+// robot stands at is outside the mapped part: the map then holds one copy, and the fit to it is unambiguous
+// (room-and-pillar: starts outside a 167 m map fixed 120 m off, turned 180 deg). Checked once per keyframe.
+bool Relocaliser::selfSimilar(const Eigen::Isometry3d& T_map_lidar) {
+  int m = -1;
+  double nearest = 1e18;
+  for (std::size_t k = 0; k < bundle_.keyframes.size(); ++k) {
+    const double d = (bundle_.keyframes[k].pose.translation() - T_map_lidar.translation()).squaredNorm();
+    if (d < nearest) nearest = d, m = static_cast<int>(k);
+  }
+  return m >= 0 && keyframeSelfSimilar(m);
+}
+
+// The share of keyframes spread evenly over the map that repeat elsewhere in it, against
+// reloc.self_similar_map_ratio: the judgement started at construction, taken over once.
+bool Relocaliser::mapSelfSimilar() {
+  if (stats_.self_similar_map >= 0) return stats_.self_similar_map == 1;
+  const MapJudgement judged = map_judgement_.valid() ? map_judgement_.get() : judgeMap();
+  int repeated = 0;
+  for (std::size_t i = 0; i < judged.samples.size(); ++i) {
+    self_similar_[static_cast<std::size_t>(judged.samples[i])] = judged.repeated[i] ? 1 : 0;
+    repeated += judged.repeated[i] ? 1 : 0;
+  }
+  const RelocStats& c = judged.counts;
+  stats_.verified += c.verified;
+  stats_.axial_searches += c.axial_searches;
+  stats_.axial_resolved += c.axial_resolved;
+  stats_.axial_ambiguous += c.axial_ambiguous;
+  stats_.self_similarity_checks += static_cast<int>(judged.samples.size());
+  const auto samples = static_cast<double>(judged.samples.size());
+  stats_.self_similar_map = samples > 0 && repeated >= config_.self_similar_map_ratio * samples ? 1 : 0;
+  return stats_.self_similar_map == 1;
+}
+
+Relocaliser::MapJudgement Relocaliser::judgeMap() const {
+  MapJudgement out;
+  const int n = static_cast<int>(bundle_.keyframes.size());
+  const int samples = std::min(n, config_.self_similar_samples);
+  for (int i = 0; i < samples; ++i) {
+    const int k = static_cast<int>((2 * static_cast<std::int64_t>(i) + 1) * n / (2 * samples));
+    out.samples.push_back(k);
+    out.repeated.push_back(repeatsElsewhere(k, out.counts));
+  }
+  return out;
+}
+
+// A keyframe's check, cached (the map's sampled keyframes come from the judgement).
+bool Relocaliser::keyframeSelfSimilar(int m) {
+  mapSelfSimilar();  // takes the judgement's results into the cache first: each keyframe is checked once
+  signed char& known = self_similar_[static_cast<std::size_t>(m)];
+  if (known < 0) {
+    ++stats_.self_similarity_checks;
+    known = repeatsElsewhere(m, stats_) ? 1 : 0;
+  }
+  return known == 1;
+}
+
+// Keyframe m's own cloud and Scan Context, queried as a relocalising query would be against every candidate whose
+// submap does not hold m itself: a tight fit that lands more than reloc.ambiguity_distance from m is a twin.
+bool Relocaliser::repeatsElsewhere(int m, RelocStats& stats) const {
+  const BundleKeyframe& keyframe = bundle_.keyframes[static_cast<std::size_t>(m)];
+  const std::vector<Eigen::Vector3f> source = querySource(keyframe.cloud.decode(), loop_.verifier);
+  const double r2 = config_.submap_radius * config_.submap_radius;
+  int verified = 0;
+  for (const ScanContextCandidate& c : alias_database_.query(keyframe.context, 0)) {
+    if (c.distance > loop_.max_scan_context_distance || verified >= config_.max_verifications) break;
+    const BundleKeyframe& other = bundle_.keyframes[static_cast<std::size_t>(c.index)];
+    const bool holds_itself = std::abs(c.index - m) <= config_.submap_neighbors ||
+                              (other.pose.translation() - keyframe.pose.translation()).squaredNorm() <= r2;
+    if (holds_itself) continue;  // its fit would find the keyframe's own place
+    ++verified;
+    const std::unique_ptr<PlaneTarget> target = candidateTarget(neighbourhood(c.index), loop_.verifier);
+    AxialSearchResult search;
+    const LoopVerification v = verify(*target, source,
+                                      scanContextSeed(keyframe.pose, other.pose, c.yaw, loop_.level_scan_context), search, stats);
+    const Eigen::Isometry3d at = other.pose * v.T_match_query;
+    if (v.verdict == LoopVerdict::kAccepted &&
+        (at.translation() - keyframe.pose.translation()).norm() > config_.ambiguity_distance)
+      return true;
+  }
+  return false;
 }
 
 // The loop closer's pairwise cycle test: the two fits and the session's motion between the queries must close.

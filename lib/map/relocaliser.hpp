@@ -22,6 +22,7 @@
 #include "map/map_bundle.hpp"
 
 #include <deque>
+#include <future>
 #include <optional>
 #include <vector>
 
@@ -48,6 +49,16 @@ struct RelocaliserConfig {
   double max_track_correction = 1.0;  // m: a tracking fit moving the pose more than this is refused
   int max_track_failures = 8;       // failed tracking verifications in a row: lost
   double max_stall_s = 1.0;         // a gap in the input longer than this: lost
+  // A fix at a place the map itself repeats is refused: the map's own keyframe there, queried like a
+  // relocalising query, also fits tightly somewhere else. A pillar grid or a run of identical cross-cuts is
+  // locally the same from many places, and a robot outside the mapped part sees the same as one inside it.
+  // A map most of whose places repeat (a regular pillar grid: every place there has a twin, mapped or not)
+  // cannot place a robot that may have started outside it: every fix is refused. Judged on the first
+  // candidate fix from self_similar_samples keyframes spread over the map.
+  bool refuse_self_similar = true;
+  int self_similar_candidates = 100;  // Scan Context candidates ranked when looking for the keyframe's alias
+  int self_similar_samples = 12;      // keyframes checked to judge the whole map
+  double self_similar_map_ratio = 0.5;  // share of them that must repeat for the map to count as self-similar
   // A query's fit that is tight but weak along the roadway is searched along it (map/axial_search.hpp).
   AxialSearchConfig axial;
 };
@@ -67,6 +78,9 @@ struct RelocStats {
   int axial_ambiguous = 0;      // ... where a fit elsewhere along the line came within the margin
   int rejected_ambiguous = 0;   // a fit elsewhere nearly as good
   int rejected_inconsistent = 0;// disagreed with the pending fixes
+  int rejected_self_similar = 0;// the fix's place is repeated elsewhere in the map
+  int self_similarity_checks = 0;  // bundle keyframes checked for an alias (each once)
+  int self_similar_map = -1;       // the whole map judged self-similar: 1 yes, 0 no, -1 not judged yet
   int fixes = 0;                // times localised (first fix and each relocalisation after being lost)
   int lost = 0;
   int track_verified = 0, track_failed = 0;
@@ -77,7 +91,7 @@ struct RelocStats {
 // or was not taken. Kept only while relocalising, at most kMaxQueryLog.
 struct RelocQueryRecord {
   std::int64_t utime = 0;
-  const char* outcome = "";        // candidate, no_candidate, fit, degenerate, ambiguous
+  const char* outcome = "";        // candidate, no_candidate, fit, degenerate, ambiguous, self_similar
   Eigen::Isometry3d T_map_lidar = Eigen::Isometry3d::Identity();  // the best fit, when there was one
   double inlier_ratio = 0.0, runner_up = 0.0;
 };
@@ -85,6 +99,10 @@ struct RelocQueryRecord {
 class Relocaliser {
  public:
   Relocaliser(MapBundle bundle, const LoopCloserConfig& loop, const RelocaliserConfig& config);
+  // The map's self-similarity is judged on a thread that refers to this object: it is neither copied nor moved.
+  Relocaliser(const Relocaliser&) = delete;
+  Relocaliser& operator=(const Relocaliser&) = delete;
+  ~Relocaliser();
 
   struct Result {
     RelocState state = RelocState::kRelocalising;
@@ -100,6 +118,10 @@ class Relocaliser {
   const std::vector<RelocQueryRecord>& queryLog() const { return query_log_; }
   static constexpr std::size_t kMaxQueryLog = 2000;
   const MapBundle& bundle() const { return bundle_; }
+  // Whether most places of the map repeat elsewhere in it (reloc.self_similar_samples keyframes spread over it,
+  // each queried against the rest as a relocalising query would be). Judged once, from the bundle alone (waits
+  // for the judgement started at construction); with reloc.refuse_self_similar such a map gives no fix.
+  bool mapSelfSimilar();
 
  private:
   struct Fix {
@@ -112,9 +134,19 @@ class Relocaliser {
   void track(const PoseEstimate& session);
   std::optional<Fix> query(const PoseEstimate& session, const std::vector<Eigen::Vector3f>& cloud);
   std::optional<Fix> bestFix(const PoseEstimate& session, const std::vector<Eigen::Vector3f>& cloud, RelocQueryRecord& record);
+  // ICP with the search along a weak direction; counts into `stats` (the background judgement has its own).
   LoopVerification verify(const PlaneTarget& target, const std::vector<Eigen::Vector3f>& source,
-                          const Eigen::Isometry3d& seed, AxialSearchResult& search);
+                          const Eigen::Isometry3d& seed, AxialSearchResult& search, RelocStats& stats) const;
   bool consistent(const Fix& a, const Fix& b) const;
+  bool selfSimilar(const Eigen::Isometry3d& T_map_lidar);
+  bool keyframeSelfSimilar(int keyframe);
+  bool repeatsElsewhere(int keyframe, RelocStats& stats) const;  // reads only the bundle: safe on any thread
+  struct MapJudgement {
+    std::vector<int> samples;
+    std::vector<bool> repeated;
+    RelocStats counts;  // verifications and searches it made
+  };
+  MapJudgement judgeMap() const;
   CandidateNeighbourhood neighbourhood(int match) const;
   CompactCloud queryCloud(const Eigen::Isometry3d& session) const;
   void loseFix();
@@ -123,6 +155,8 @@ class Relocaliser {
   LoopCloserConfig loop_;
   RelocaliserConfig config_;
   ScanContextDatabase database_;
+  ScanContextDatabase alias_database_;  // the same contexts, more candidates per query (selfSimilar)
+  std::vector<signed char> self_similar_;  // per bundle keyframe: -1 not checked yet, 0 no, 1 yes
   RelocState state_ = RelocState::kRelocalising;
   Eigen::Isometry3d T_map_session_ = Eigen::Isometry3d::Identity();
   std::vector<Fix> pending_;
@@ -137,6 +171,7 @@ class Relocaliser {
   std::int64_t last_query_utime_ = 0;
   int track_failures_ = 0;
   std::deque<std::pair<Eigen::Isometry3d, std::vector<Eigen::Vector3f>>> recent_;  // newest query_sweeps sweeps
+  std::future<MapJudgement> map_judgement_;  // last member: joined before the rest is destroyed
 };
 
 }  // namespace adit

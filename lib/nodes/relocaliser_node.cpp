@@ -85,6 +85,8 @@ class RelocaliserNode : public runtime::Node, public WritesProducts {
     setCount("rejected_degenerate", s.rejected_degenerate);
     setCount("rejected_ambiguous", s.rejected_ambiguous);
     setCount("rejected_inconsistent", s.rejected_inconsistent);
+    setCount("rejected_self_similar", s.rejected_self_similar);
+    setCount("self_similar_map", s.self_similar_map);
     setCount("track_failed", s.track_failed);
   }
 
@@ -109,10 +111,10 @@ class RelocaliserNode : public runtime::Node, public WritesProducts {
         "{{\n  \"state\": \"{}\",\n  \"first_fix_sensor_s\": {:.3f},\n  \"first_fix_utime\": {},\n"
         "  \"first_fix_compute_ms\": {:.1f},\n  \"poses_in_map\": {},\n  \"queries\": {},\n  \"fixes\": {},\n"
         "  \"lost\": {},\n  \"rejected_fit\": {},\n  \"rejected_degenerate\": {},\n  \"rejected_ambiguous\": {},\n  \"rejected_inconsistent\": {},\n"
-        "  \"axial_searches\": {},\n  \"axial_resolved\": {},\n  \"axial_ambiguous\": {},\n"
+        "  \"rejected_self_similar\": {},\n  \"self_similarity_checks\": {},\n  \"self_similar_map\": {},\n  \"axial_searches\": {},\n  \"axial_resolved\": {},\n  \"axial_ambiguous\": {},\n"
         "  \"track_verified\": {},\n  \"track_failed\": {},\n  \"track_degenerate\": {}\n}}\n",
         state(), fix_s, first_fix_.value_or(0), compute_ms_, in_map_.size(), s.queries, s.fixes, s.lost, s.rejected_fit, s.rejected_degenerate,
-        s.rejected_ambiguous, s.rejected_inconsistent, s.axial_searches, s.axial_resolved, s.axial_ambiguous, s.track_verified, s.track_failed, s.track_degenerate);
+        s.rejected_ambiguous, s.rejected_inconsistent, s.rejected_self_similar, s.self_similarity_checks, s.self_similar_map, s.axial_searches, s.axial_resolved, s.axial_ambiguous, s.track_verified, s.track_failed, s.track_degenerate);
   }
 
   std::optional<Relocaliser> relocaliser_;

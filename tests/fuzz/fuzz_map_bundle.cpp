@@ -50,6 +50,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     reloc.max_verifications = 1;
     reloc.submap_neighbors = 1;
     reloc.query_sweeps = 1;
+    reloc.self_similar_samples = 1;  // the map's self-similarity from one keyframe (its judgement runs on a thread)
     adit::Relocaliser relocaliser(std::move(bundle), adit::LoopCloserConfig{}, reloc);
     adit::PoseEstimate session;
     for (int k = 0; k < 2; ++k) {
