@@ -1,5 +1,7 @@
 #include "drivers/packet_clock.hpp"
 
+#include <cmath>
+
 namespace adit::drivers {
 namespace {
 
@@ -8,8 +10,12 @@ constexpr std::int64_t kHourUs = 3600LL * 1000000;
 }  // namespace
 
 std::optional<PacketTime> PacketClock::place(const DecodedPacket& packet, std::int64_t host_receive_ns) {
-  return config_.source == TimeSource::kSensor ? placeBySensor(packet, host_receive_ns)
-                                               : placeByHost(packet, host_receive_ns);
+  switch (config_.source) {
+    case TimeSource::kSensor: return placeBySensor(packet, host_receive_ns);
+    case TimeSource::kUtc: return placeByUtc(packet, host_receive_ns);
+    case TimeSource::kHost: break;
+  }
+  return placeByHost(packet, host_receive_ns);
 }
 
 bool PacketClock::accept(std::int64_t first_ns, const DecodedPacket& packet) {
@@ -61,6 +67,22 @@ std::optional<PacketTime> PacketClock::placeBySensor(const DecodedPacket& packet
   if (packet.clock == SensorClock::kMicrosPastHour) hour_wraps_ = (stamp - packet.stamp_us) / kHourUs;
   last_stamp_us_ = stamp;
   last_duration_ns_ = packet.duration_ns;
+  return t;
+}
+
+std::optional<PacketTime> PacketClock::placeByUtc(const DecodedPacket& packet, std::int64_t host_receive_ns) {
+  const std::int64_t receive_us = host_receive_ns / 1000;
+  std::int64_t stamp = packet.stamp_us;
+  if (packet.clock == SensorClock::kMicrosPastHour) {
+    stamp += receive_us - receive_us % kHourUs;  // the receive time's hour, or its neighbour nearer the stamp
+    if (stamp > receive_us + kHourUs / 2) stamp -= kHourUs;
+    else if (stamp < receive_us - kHourUs / 2) stamp += kHourUs;
+  }
+  PacketTime t;
+  t.first_firing_ns = stamp * 1000;
+  const double off_s = static_cast<double>(host_receive_ns - packet.duration_ns - t.first_firing_ns) * 1e-9;
+  t.far_from_host = std::abs(off_s) > config_.max_jump_s;
+  if (!accept(t.first_firing_ns, packet)) return std::nullopt;
   return t;
 }
 

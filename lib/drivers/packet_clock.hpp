@@ -9,6 +9,10 @@
 //   of the sensor clock by more than max_jump (GPS lock, a reset) restarts the estimator (re-anchor), never
 //   behind what was already published. A refit may move the line back by microseconds (up to a jitter's
 //   worth while the first windows fill): a packet that would overlap the previous one is shifted forward.
+// kUtc: the sensor's clock is UTC (GPS / PPS) and so is the host's (chrony, PTP): the stamp is the first
+//   firing's time as it is, the Velodyne's hour taken as the one that puts the stamp nearest to the receive
+//   time. A stamp further than max_jump from the receive time is still used, and flagged (far_from_host):
+//   one of the clocks is not on UTC.
 // kHost: the host receive time (kernel stamp) minus the packet's duration is the first firing. Network
 //   jitter can make a packet start a little before the previous one ended; up to one packet duration of
 //   overlap is shifted forward (counted), more is a time step back.
@@ -25,7 +29,7 @@
 
 namespace adit::drivers {
 
-enum class TimeSource { kSensor, kHost };
+enum class TimeSource { kSensor, kUtc, kHost };
 
 struct PacketClockConfig {
   TimeSource source = TimeSource::kSensor;
@@ -41,6 +45,7 @@ struct PacketTime {
   std::int64_t first_firing_ns = 0;  // output time of the packet's first firing
   bool reanchored = false;           // kSensor: the sensor clock jumped and was re-anchored
   bool shifted = false;              // shifted forward over the previous packet's end
+  bool far_from_host = false;        // kUtc: the stamp is further than max_jump from the receive time
 };
 
 class PacketClock {
@@ -52,6 +57,7 @@ class PacketClock {
 
  private:
   std::optional<PacketTime> placeBySensor(const DecodedPacket& packet, std::int64_t host_receive_ns);
+  std::optional<PacketTime> placeByUtc(const DecodedPacket& packet, std::int64_t host_receive_ns);
   std::optional<PacketTime> placeByHost(const DecodedPacket& packet, std::int64_t host_receive_ns);
   // Accepts a packet starting at first_ns if it does not start before the previous one ended.
   bool accept(std::int64_t first_ns, const DecodedPacket& packet);

@@ -177,8 +177,9 @@ LidarStreamConfig streamConfigOf(const UdpLidarConfig& config) {
     throw std::invalid_argument("lidar driver: vertical_angles_deg needs 16 values, got " +
                                 std::to_string(s.elevations_deg.size()));
   if (config.time_source == "sensor") s.clock.source = TimeSource::kSensor;
+  else if (config.time_source == "utc") s.clock.source = TimeSource::kUtc;
   else if (config.time_source == "host") s.clock.source = TimeSource::kHost;
-  else throw std::invalid_argument("lidar driver: time_source '" + config.time_source + "' (sensor or host)");
+  else throw std::invalid_argument("lidar driver: time_source '" + config.time_source + "' (sensor, utc or host)");
   if (!(config.max_clock_jump_s > 0) || !(config.max_sweep_duration_s > 0) || !(config.max_firing_gap_s > 0) ||
       !std::isfinite(config.cut_azimuth_deg) || !(config.idle_timeout_s >= 0) ||
       !(config.transport_delay_s >= 0 && config.transport_delay_s < 1))

@@ -33,7 +33,8 @@ struct UdpLidarConfig {
   // lidar_driver.sensor_name: LidarScan::sensor / point_cloud_t.sensor; "" = the model name.
   std::string sensor_name;
   // lidar_driver.time_source: "sensor" (the packets' own stamps mapped onto the host clock by a filtered
-  // offset and drift: exact firing spacing, immune to network jitter) or "host" (kernel receive time).
+  // offset and drift: exact firing spacing, immune to network jitter), "utc" (the stamps as they are: a
+  // GPS/PPS-synchronised sensor and a host on UTC) or "host" (kernel receive time).
   std::string time_source = "sensor";
   // lidar_driver.max_clock_jump_s: a sensor clock step larger than this re-anchors on the host clock (s).
   double max_clock_jump_s = 1.0;

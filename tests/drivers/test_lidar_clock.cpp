@@ -131,5 +131,43 @@ TEST(LidarClockSync, LidarAndImuPutTheSameInstantAtTheSameHostTime) {
             << " packets\n";
 }
 
+// A sensor on UTC (GPS / PPS) with a host on UTC: the stamps are the firing times as they are, whatever the
+// receive jitter; the VLP-16's hour comes from the receive time, also across an hour boundary, and an RS-16's
+// date is used as it is. A clock that is not on UTC is still used, and flagged.
+TEST(LidarClockUtc, StampsOfASynchronisedSensorAreUsedAsTheyAre) {
+  PacketClockConfig config;
+  config.source = TimeSource::kUtc;
+  PacketClock velodyne(config), robosense(config);
+  Jitter jitter(21);
+  const std::int64_t hour_start_us = 1'800'000'000LL * 1'000'000 / kHourUs * kHourUs;
+  const std::int64_t t0_us = hour_start_us + kHourUs - 500'000;  // the hour turns 0.5 s in
+  for (int k = 0; k < 2000; ++k) {
+    const std::int64_t true_us = t0_us + k * 1327;
+    DecodedPacket p;
+    p.duration_ns = kDurationNs;
+    const auto receive_ns = static_cast<std::int64_t>((true_us + kDurationNs * 1e-3 + jitter.delayUs(300)) * 1000);
+    p.clock = SensorClock::kMicrosPastHour;
+    p.stamp_us = true_us % kHourUs;
+    const auto v = velodyne.place(p, receive_ns);
+    ASSERT_TRUE(v.has_value()) << k;
+    EXPECT_EQ(v->first_firing_ns, true_us * 1000) << k;
+    EXPECT_FALSE(v->far_from_host);
+    p.clock = SensorClock::kUtcMicros;
+    p.stamp_us = true_us;
+    const auto r = robosense.place(p, receive_ns);
+    ASSERT_TRUE(r.has_value()) << k;
+    EXPECT_EQ(r->first_firing_ns, true_us * 1000) << k;
+  }
+  PacketClock free_running(config);
+  DecodedPacket p;
+  p.duration_ns = kDurationNs;
+  p.clock = SensorClock::kUtcMicros;
+  p.stamp_us = 946'684'800LL * 1'000'000;  // 2000-01-01: a RoboSense whose clock was never set
+  const auto f = free_running.place(p, t0_us * 1000);
+  ASSERT_TRUE(f.has_value());
+  EXPECT_TRUE(f->far_from_host);
+  EXPECT_EQ(f->first_firing_ns, p.stamp_us * 1000);
+}
+
 }  // namespace
 }  // namespace adit::drivers
