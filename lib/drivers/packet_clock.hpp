@@ -16,8 +16,8 @@
 // kHost: the host receive time (kernel stamp) minus the packet's duration is the first firing. Network
 //   jitter can make a packet start a little before the previous one ended; up to one packet duration of
 //   overlap is shifted forward (counted), more is a time step back.
-// A packet that would still start before the previous packet's last firing (kHost), or whose sensor stamp
-// is not past the previous packet's (kSensor: a repeated or late packet), is refused (counted by the caller
+// A packet that would still start before the previous packet's last firing (kHost, kUtc), or whose sensor
+// stamp is not past the previous packet's (kSensor: a repeated or late packet), is refused (counted by the caller
 // as "time_backwards") and the clock stays as it was.
 #pragma once
 
@@ -33,8 +33,9 @@ enum class TimeSource { kSensor, kUtc, kHost };
 
 struct PacketClockConfig {
   TimeSource source = TimeSource::kSensor;
-  // Sensor clock steps larger than this (either way, s) re-anchor on the host clock. 1 s: far above the
-  // 1.3 ms packet spacing and any network delay, far below a GPS correction of a free-running clock.
+  // Sensor clock steps larger than this (either way, s) re-anchor on the host clock (kUtc: a stamp this far
+  // from the receive time is flagged). 1 s: far above the 1.3 ms packet spacing and any network delay, far
+  // below a GPS correction of a free-running clock.
   double max_jump_s = 1.0;
   // kSensor: the offset / drift estimator; its transport_delay_s is the fixed delay from a packet's last
   // firing to its receive time (the sensor's send and the wire), which no one-way estimate can see.
