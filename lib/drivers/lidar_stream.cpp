@@ -38,7 +38,7 @@ bool worthLogging(std::int64_t n) {
 
 LidarPacketStream::LidarPacketStream(const LidarStreamConfig& config)
     : config_(config),
-      sensor_time_(config.clock.source == TimeSource::kSensor),
+      sensor_time_(config.clock.source != TimeSource::kHost),
       host_time_fallback_(config.host_time_fallback),
       clock_config_(config.clock),
       clock_(config.clock),
@@ -160,6 +160,11 @@ void LidarPacketStream::push(const std::uint8_t* data, std::size_t size, std::in
     spdlog::warn("lidar clock jumped (packet stamp {} us): re-anchored on the host clock", packet_.stamp_us);
   }
   if (t->shifted) health_.counters["time_shifted"] += 1;
+  if (t->far_from_host) {
+    const std::int64_t n = health_.counters["clock_not_utc"] += 1;
+    if (n == 1) spdlog::warn("lidar stamp {} us is far from the receive time: time_source utc needs the sensor and the "
+                             "host on UTC (GPS/PPS, chrony); use 'sensor' for a free-running clock", packet_.stamp_us);
+  }
   placed_any_ = true;
   health_.last_input_utime = t->first_firing_ns / 1000;
   const std::size_t before = sweeps.size();

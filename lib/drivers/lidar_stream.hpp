@@ -51,7 +51,7 @@ struct LidarStreamConfig {
 //     unknown_product, unknown_return_mode;
 //   skipped packets (Health::drops): time_backwards;
 //   sweeps not published (Health::drops): partial_sweep, sweep_too_long;
-//   events: packet_gap, time_reanchor, time_shifted, empty_sweep, partial_sweep_published.
+//   events: packet_gap, time_reanchor, time_shifted, clock_not_utc, empty_sweep, partial_sweep_published.
 class LidarPacketStream {
  public:
   // Throws std::invalid_argument on a bad elevation table.

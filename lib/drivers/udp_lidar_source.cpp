@@ -146,6 +146,7 @@ UdpLidarConfig udpLidarConfigFrom(const Config& c) {
   d.sensor_name = c.get(k + "sensor_name", d.sensor_name);
   d.time_source = c.get(k + "time_source", d.time_source);
   d.max_clock_jump_s = c.get(k + "max_clock_jump_s", d.max_clock_jump_s);
+  d.transport_delay_s = c.get(k + "transport_delay_s", d.transport_delay_s);
   d.cut_azimuth_deg = c.get(k + "cut_azimuth_deg", d.cut_azimuth_deg);
   d.max_sweep_duration_s = c.get(k + "max_sweep_duration_s", d.max_sweep_duration_s);
   d.max_firing_gap_s = c.get(k + "max_firing_gap_s", d.max_firing_gap_s);
@@ -176,13 +177,16 @@ LidarStreamConfig streamConfigOf(const UdpLidarConfig& config) {
     throw std::invalid_argument("lidar driver: vertical_angles_deg needs 16 values, got " +
                                 std::to_string(s.elevations_deg.size()));
   if (config.time_source == "sensor") s.clock.source = TimeSource::kSensor;
+  else if (config.time_source == "utc") s.clock.source = TimeSource::kUtc;
   else if (config.time_source == "host") s.clock.source = TimeSource::kHost;
-  else throw std::invalid_argument("lidar driver: time_source '" + config.time_source + "' (sensor or host)");
+  else throw std::invalid_argument("lidar driver: time_source '" + config.time_source + "' (sensor, utc or host)");
   if (!(config.max_clock_jump_s > 0) || !(config.max_sweep_duration_s > 0) || !(config.max_firing_gap_s > 0) ||
-      !std::isfinite(config.cut_azimuth_deg) || !(config.idle_timeout_s >= 0))
+      !std::isfinite(config.cut_azimuth_deg) || !(config.idle_timeout_s >= 0) ||
+      !(config.transport_delay_s >= 0 && config.transport_delay_s < 1))
     throw std::invalid_argument("lidar driver: max_clock_jump_s, max_sweep_duration_s and max_firing_gap_s must be "
-                                "> 0, cut_azimuth_deg finite, idle_timeout_s >= 0");
+                                "> 0, cut_azimuth_deg finite, idle_timeout_s >= 0, transport_delay_s in [0, 1)");
   s.clock.max_jump_s = config.max_clock_jump_s;
+  s.clock.sync.transport_delay_s = config.transport_delay_s;
   s.sweep.cut_azimuth_deg = config.cut_azimuth_deg;
   s.sweep.max_sweep_duration_s = config.max_sweep_duration_s;
   s.sweep.max_firing_gap_s = config.max_firing_gap_s;

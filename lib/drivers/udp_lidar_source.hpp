@@ -32,11 +32,16 @@ struct UdpLidarConfig {
   std::string channel = "LIDAR_POINTS";
   // lidar_driver.sensor_name: LidarScan::sensor / point_cloud_t.sensor; "" = the model name.
   std::string sensor_name;
-  // lidar_driver.time_source: "sensor" (the packets' own stamps, anchored to the host clock at the first
-  // packet: exact firing spacing, immune to network jitter) or "host" (kernel receive time of each packet).
+  // lidar_driver.time_source: "sensor" (the packets' own stamps mapped onto the host clock by a filtered
+  // offset and drift: exact firing spacing, immune to network jitter), "utc" (the stamps as they are: a
+  // GPS/PPS-synchronised sensor and a host on UTC) or "host" (kernel receive time).
   std::string time_source = "sensor";
   // lidar_driver.max_clock_jump_s: a sensor clock step larger than this re-anchors on the host clock (s).
   double max_clock_jump_s = 1.0;
+  // lidar_driver.transport_delay_s: sensor time: the fixed delay from a packet's last firing to its host
+  // receive time (the sensor's send, the wire), subtracted; one-way timing cannot measure it. 0 = unknown
+  // (tens of microseconds on a direct Ethernet link).
+  double transport_delay_s = 0.0;
   // lidar_driver.cut_azimuth_deg, max_sweep_duration_s, max_firing_gap_s: see SweepAssemblerConfig.
   double cut_azimuth_deg = 180.0;
   double max_sweep_duration_s = 0.25;

@@ -10,6 +10,7 @@
 #include "runtime/process.hpp"
 #include "runtime/run_folder.hpp"
 #include "view/log_player.hpp"
+#include "view/page_command.hpp"
 #include "view/view_session.hpp"
 
 #include <adit/command_t.hpp>
@@ -46,13 +47,12 @@ void onMessage(const lcm::ReceiveBuffer* rbuf, const std::string& channel, adit:
   consumer->apply(channel, static_cast<const std::uint8_t*>(rbuf->data), rbuf->data_size, rbuf->recv_utime);
 }
 
-// save_map NAME from the page, only with --allow-commands and only a plain file name (the receiver's rule).
+// save_map [NAME] from the page, only with --allow-commands and only a plain file name (the receiver's rule).
 // Signed with the key at key_path when there is one (processes started with a command key obey only those).
-std::string saveMap(lcm::LCM* lcm, const std::string& text, const std::string& key_path) {
-  std::istringstream in(text);
-  std::string verb, name;
-  in >> verb >> name;
+std::string saveMap(lcm::LCM* lcm, const std::vector<std::string>& arguments, const std::string& key_path) {
   if (!lcm) return "save_map needs a live run (not --log)";
+  if (arguments.size() > 1) return "save_map takes one plain file name, got " + std::to_string(arguments.size()) + " words";
+  const std::string name = arguments.empty() ? "" : arguments.front();
   if (!name.empty())
     if (const std::string problem = adit::runtime::plainFileNameProblem(name); !problem.empty())
       return "save_map '" + name + "': " + problem;
@@ -69,8 +69,9 @@ void handleCommands(adit::view::WebServer& server, adit::view::RunConsumer& cons
   for (const auto& [client, text] : server.takeMessages()) {
     if (foxglove && foxglove->message(client, text)) continue;  // a Foxglove client's subscriptions
     if (player && player->command(text, consumer)) continue;   // playback of the viewer's own log
-    if (allow_commands && text.rfind("save_map", 0) == 0) {
-      const std::string error = saveMap(lcm, text, key_path);
+    const auto save_map = allow_commands ? adit::view::saveMapArguments(text) : std::nullopt;
+    if (save_map) {
+      const std::string error = saveMap(lcm, *save_map, key_path);
       if (error.empty()) {
         spdlog::info("client {}: sent {}", client, text);
       } else {
