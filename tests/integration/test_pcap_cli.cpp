@@ -153,8 +153,8 @@ TEST_F(PcapCli, BridgePublishesTheSweepsOfTheCapture) {
   EXPECT_GE(p.count("STATUS_LIDAR_BRIDGE") ? p.at("STATUS_LIDAR_BRIDGE").size() : 0u, 1u);
 }
 
-// The 32-beam heads go the same way: `adit import pcap --sensor vlp32c|hdl32e` and the bridge with the
-// sensor's launch/sensors file give every revolution's returns as 32-beam sweeps.
+// The 32-beam heads go the same way: `adit import pcap --sensor vlp32c|hdl32e`, and the bridge given only the
+// sensor's launch/sensors file, give every revolution's returns as 32-beam sweeps.
 TEST_F(PcapCli, ThirtyTwoBeamHeadsImportAndBridge) {
   for (const auto& [name, model] : {std::pair{"vlp32c", Model::kVlp32c}, std::pair{"hdl32e", Model::kHdl32e}}) {
     SyntheticLidar lidar;
@@ -175,7 +175,8 @@ TEST_F(PcapCli, ThirtyTwoBeamHeadsImportAndBridge) {
       EXPECT_EQ(s.sensor, name);
       EXPECT_EQ(s.points.size(), returns[j + 1]) << name << " sweep " << j;
     }
-    ASSERT_EQ(run(bin("adit-lidar-bridge") + " --source pcap --path " + capture.string() + " --sensor " + name +
+    // No --sensor: the sensor file's lidar_driver.model says which head sent the packets.
+    ASSERT_EQ(run(bin("adit-lidar-bridge") + " --source pcap --path " + capture.string() +
                       " --driver-config " + ADIT_SOURCE_DIR + "/launch/sensors/" + name + ".yaml --rate 0 --lcm-url 'file://" +
                       published.string() + "?mode=w'",
                   dir_ / "bridge32.txt"),
