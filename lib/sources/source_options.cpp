@@ -23,10 +23,11 @@ void addLidarSourceOptions(CLI::App& app, LidarSourceArgs& a, bool kind_position
     app.add_option("--path", a.path, "kitti/pcd/pcap: KITTI sequence folder (sequences/NN), folder of PCD files or a "
                    "capture file")->check(CLI::ExistingPath);
   }
-  app.add_option("--driver-config", a.driver_configs, "pcap, vlp16/rs16: YAML with lidar_driver.* keys (launch/sensors/)");
-  app.add_option("--port", a.port, "pcap, vlp16/rs16: UDP data port (default 2368 / 6699)");
+  app.add_option("--driver-config", a.driver_configs, "pcap and live sensors: YAML with lidar_driver.* keys (launch/sensors/)");
+  app.add_option("--port", a.port, "pcap and live sensors: UDP data port (default 2368, RS-16 6699)");
   app.add_option("--channel", a.channel, "Channel of the sweeps");
-  app.add_option("--sensor", a.sensor, "pcap: the sensor that sent the packets (vlp16, rs16, vlp32c, hdl32e); PCD/rosbag: sensor "
+  app.add_option("--sensor", a.sensor, "pcap: the sensor that sent the packets (vlp16, rs16, vlp32c, hdl32e; default: --driver-config's "
+                 "lidar_driver.model, else vlp16); PCD/rosbag: sensor "
                  "profile for rings by elevation (vlp16, rs16, hdl64)");
   app.add_option("--beams", a.beams, "KITTI: beams of the sensor that wrote the folder (default: detected from the "
                  "first scan); PCD/rosbag: beam count for a uniform fan when the profile is unknown")->check(CLI::Range(0, 255));
@@ -48,14 +49,14 @@ std::unique_ptr<runtime::MessageSource> makeLidarSource(const LidarSourceArgs& a
   if (a.path.empty()) throw std::runtime_error("--path is required for a " + a.kind + " source");
   if (a.kind == "pcap") {
     drivers::UdpLidarConfig config = drivers::udpLidarConfigFrom(runtime::loadConfig(a.driver_configs));
-    config.model = a.sensor;
+    if (!a.sensor.empty()) config.model = a.sensor;  // else the driver config's (default vlp16)
     config.channel = a.channel;
     if (a.port > 0) config.port = a.port;
     return makePcapLidarSource(a.path, config);
   }
   if (a.kind == "kitti") return makeKittiSource(a.path, a.channel, a.beams);
   io::PcdFolderConfig cloud;
-  cloud.sensor = a.sensor;
+  if (!a.sensor.empty()) cloud.sensor = a.sensor;
   cloud.num_beams = a.beams;
   cloud.sweep_duration = a.period_s;
   if (a.kind == "pcd") return makePcdSource(a.path, cloud, a.channel);

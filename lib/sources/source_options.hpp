@@ -17,7 +17,8 @@ struct LidarSourceArgs {
   int port = 0;                              // live and pcap: UDP port (0 = the sensor's default)
   std::string channel = "LIDAR_POINTS";
   // pcap: the sensor model; PCD: sensor profile for rings by elevation when the files have no ring field.
-  std::string sensor = "vlp16";
+  // Empty: the --driver-config file's lidar_driver.model (pcap), vlp16 when neither names one.
+  std::string sensor;
   int beams = 0;              // KITTI: the sensor's (0 = detected); PCD: 0 = the profile's
   double period_s = 0.1;      // sweep period when file names are not timestamps
   // ROS bag only (import): the PointCloud2 topic, and the Imu topic imported alongside (optional).

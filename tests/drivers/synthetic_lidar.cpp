@@ -18,40 +18,94 @@ void putBe16(std::uint8_t* p, unsigned v) { p[0] = (v >> 8) & 0xFF; p[1] = v & 0
 
 }  // namespace
 
+// VLP-32C User Manual (63-9325) table 9-2, by laser id: elevation and horizontal offset delta.
+constexpr double kVlp32cElevation[32] = {-25,    -1,     -1.667, -15.639, -11.31, 0,     -0.667, -8.843,
+                                         -7.254, 0.333,  -0.333, -6.148,  -5.333, 1.333, 0.667,  -4,
+                                         -4.667, 1.667,  1,      -3.667,  -3.333, 3.333, 2.333,  -2.667,
+                                         -3,     7,      4.667,  -2.333,  -2,     15,    10.333, -1.333};
+constexpr double kVlp32cDelta[32] = {1.4, -4.2, 1.4, -1.4, 1.4, -1.4, 4.2, -1.4, 1.4, -4.2, 1.4, -1.4, 4.2, -1.4, 4.2, -1.4,
+                                     1.4, -4.2, 1.4, -4.2, 4.2, -1.4, 1.4, -1.4, 1.4, -1.4, 1.4, -4.2, 4.2, -1.4, 1.4, -1.4};
+// HDL-32E User's Manual (63-9113) vertical angles: even ids the lower half, odd ids the upper half.
+constexpr double kHdl32eLow[16] = {-30.67, -29.33, -28.00, -26.67, -25.33, -24.00, -22.67, -21.33,
+                                   -20.00, -18.67, -17.33, -16.00, -14.67, -13.33, -12.00, -10.67};
+constexpr double kHdl32eHigh[16] = {-9.33, -8.00, -6.67, -5.33, -4.00, -2.67, -1.33, 0.00,
+                                    1.33,  2.67,  4.00,  5.33,  6.67,  8.00,  9.33,  10.67};
+
+int beamsOf(Model model) { return model == Model::kVlp32c || model == Model::kHdl32e ? 32 : 16; }
+
 double elevationDeg(Model model, int laser) {
-  if (model == Model::kVlp16) return laser % 2 == 0 ? -15.0 + laser : static_cast<double>(laser);
-  return laser < 8 ? -15.0 + 2 * laser : 15.0 - 2 * (laser - 8);
+  switch (model) {
+    case Model::kVlp16: return laser % 2 == 0 ? -15.0 + laser : static_cast<double>(laser);
+    case Model::kRs16: return laser < 8 ? -15.0 + 2 * laser : 15.0 - 2 * (laser - 8);
+    case Model::kVlp32c: return kVlp32cElevation[laser];
+    case Model::kHdl32e: return laser % 2 == 0 ? kHdl32eLow[laser / 2] : kHdl32eHigh[laser / 2];
+  }
+  return 0.0;
 }
+
+double azimuthOffsetDeg(Model model, int laser) { return model == Model::kVlp32c ? kVlp32cDelta[laser] : 0.0; }
 
 int ringOf(Model model, int laser) {
-  if (model == Model::kVlp16) return laser % 2 == 0 ? laser / 2 : 8 + laser / 2;
-  return laser < 8 ? laser : 23 - laser;
+  int rank = 0;  // lasers below it (ties: the lower id first)
+  for (int other = 0; other < beamsOf(model); ++other) {
+    const double a = elevationDeg(model, other), b = elevationDeg(model, laser);
+    if (a < b || (a == b && other < laser)) ++rank;
+  }
+  return rank;
 }
 
+namespace {
+
+// Per head: distance unit, time between firings, lasers fired together, and the firing sequences in a
+// (single-return) block.
+struct Timing {
+  double unit_m;
+  std::int64_t sequence_ns, firing_ns;
+  int lasers_per_firing, sequences_per_block;
+  std::uint8_t product;
+};
+
+Timing timingOf(Model model) {
+  switch (model) {
+    case Model::kVlp16: return {0.002, 55296, 2304, 1, 2, 0x22};
+    case Model::kRs16: return {0.005, 55500, 2800, 1, 2, 0};
+    case Model::kVlp32c: return {0.004, 55296, 2304, 2, 1, 0x28};
+    case Model::kHdl32e: return {0.002, 46080, 1152, 1, 1, 0x21};
+  }
+  return {};
+}
+
+}  // namespace
+
 // RS-16 dual return: one sequence per block (both echoes in it), so a block is one sequence long.
-std::int64_t SyntheticLidar::blockNs() const { return model == Model::kVlp16 ? 110592 : dual ? 55500 : 111000; }
-int SyntheticLidar::groupsPerPacket() const { return dual && model == Model::kVlp16 ? 6 : 12; }
+std::int64_t SyntheticLidar::blockNs() const {
+  const Timing t = timingOf(model);
+  return model == Model::kRs16 && dual ? t.sequence_ns : t.sequence_ns * t.sequences_per_block;
+}
+int SyntheticLidar::groupsPerPacket() const { return dual && model != Model::kRs16 ? 6 : 12; }
 std::int64_t SyntheticLidar::lastFiringNs() const {
-  if (model == Model::kVlp16) return packetNs() - blockNs() + 55296 + 15 * 2304;
-  return packetNs() - blockNs() + (dual ? 0 : 55500) + 15 * 2800;
+  const Timing t = timingOf(model);
+  const int firings = beamsOf(model) / t.lasers_per_firing;
+  if (model == Model::kRs16) return packetNs() - blockNs() + (dual ? 0 : 55500) + (firings - 1) * t.firing_ns;
+  return packetNs() - t.sequence_ns + (firings - 1) * t.firing_ns;
 }
 
 std::int64_t SyntheticLidar::stampUs(int k) const {
   const std::int64_t us = stamp0_us + (static_cast<std::int64_t>(k) * packetNs()) / 1000;  // whole us, truncated
-  return model == Model::kVlp16 ? us % 3600000000LL : us;
+  return model == Model::kRs16 ? us : us % 3600000000LL;
 }
 
 std::vector<std::uint8_t> SyntheticLidar::packet(int k, std::vector<TruthFiring>* truth) const {
-  const bool vlp = model == Model::kVlp16;
+  const bool vlp = model != Model::kRs16;  // the Velodyne family
+  const Timing timing = timingOf(model);
   const std::size_t header = vlp ? 0 : 42;
   std::vector<std::uint8_t> bytes(vlp ? 1206 : 1248, 0);
-  const double unit = vlp ? 0.002 : 0.005;
-  const std::int64_t sequence_ns = vlp ? 55296 : 55500, firing_ns = vlp ? 2304 : 2800;
-  const int returns = dual ? 2 : 1;
-  // VLP-16 dual: block pairs (one per echo) of two sequences; RS-16 dual: one block of one sequence whose
-  // slots 0..15 hold the first echo and 16..31 the second.
+  const double unit = timing.unit_m;
+  const int returns = dual ? 2 : 1, beams = beamsOf(model);
+  // Velodyne dual: block pairs (one per echo) of the single-return block's sequences; RS-16 dual: one block
+  // of one sequence whose slots 0..15 hold the first echo and 16..31 the second.
   const bool rs_dual = !vlp && dual;
-  const int blocks_per_group = rs_dual ? 1 : returns, sequences = rs_dual ? 1 : 2;
+  const int blocks_per_group = rs_dual ? 1 : returns, sequences = rs_dual ? 1 : timing.sequences_per_block;
   for (int g = 0; g < groupsPerPacket(); ++g) {
     const std::int64_t n = static_cast<std::int64_t>(k) * groupsPerPacket() + g;  // global block (group) index
     const int az_raw = static_cast<int>((az0_centideg + gap_centideg * n) % 36000);
@@ -62,13 +116,19 @@ std::vector<std::uint8_t> SyntheticLidar::packet(int k, std::vector<TruthFiring>
       vlp ? putLe16(block + 2, az_raw) : putBe16(block + 2, az_raw);
     }
     for (int s = 0; s < sequences; ++s) {
-      for (int laser = 0; laser < 16; ++laser) {
-        const std::int64_t in_block = s * sequence_ns + laser * firing_ns;
+      for (int laser = 0; laser < beams; ++laser) {
+        const std::int64_t in_block = s * timing.sequence_ns + (laser / timing.lasers_per_firing) * timing.firing_ns;
+        const double az = az0_centideg + gap_centideg * (static_cast<double>(n) + static_cast<double>(in_block) /
+                                                                                     static_cast<double>(blockNs()));
+        const double e = elevationDeg(model, laser) * M_PI / 180.0,
+                     a = (az / 100.0 + azimuthOffsetDeg(model, laser)) * M_PI / 180.0;
+        const Eigen::Vector3d direction(std::cos(e) * std::cos(a), -std::cos(e) * std::sin(a), std::sin(e));
         unsigned first_raw = 0;
         for (int r = 0; r < returns; ++r) {
-          const std::uint64_t h = mix(seed ^ mix(static_cast<std::uint64_t>(n * 64 + s * 16 + laser) * 4 + r));
+          const std::uint64_t h = mix(seed ^ mix(static_cast<std::uint64_t>(n * 64 + s * beams + laser) * 4 + r));
           const double u = static_cast<double>(h >> 11) / 9007199254740992.0;  // [0, 1)
-          unsigned raw = static_cast<unsigned>(std::lround((0.5 + 99.5 * u) / unit));
+          const double range = scene && r == 0 ? scene(direction) : 0.5 + 99.5 * u;
+          unsigned raw = static_cast<unsigned>(std::lround(range / unit));
           if (r == 1 && (h & 3) == 0) raw = first_raw;  // strongest echo == last echo
           if (static_cast<double>(mix(h) >> 11) / 9007199254740992.0 < no_return_fraction) raw = 0;
           if (r == 0) first_raw = raw;
@@ -81,18 +141,13 @@ std::vector<std::uint8_t> SyntheticLidar::packet(int k, std::vector<TruthFiring>
           TruthFiring f;
           f.offset_ns = g * blockNs() + in_block;
           f.t_ns = static_cast<std::int64_t>(k) * packetNs() + f.offset_ns;
-          const double az = az0_centideg + gap_centideg * (static_cast<double>(n) + static_cast<double>(in_block) /
-                                                                                       static_cast<double>(blockNs()));
           f.azimuth_deg = std::fmod(az, 36000.0) / 100.0;
           f.laser = laser;
           f.ring = ringOf(model, laser);
           f.range_m = raw * unit;
           f.intensity = intensity;
           f.has_return = raw != 0 && !(r == 1 && raw == first_raw);
-          const double e = elevationDeg(model, laser) * M_PI / 180.0, a = f.azimuth_deg * M_PI / 180.0;
-          if (f.has_return)
-            f.p = {f.range_m * std::cos(e) * std::cos(a), -f.range_m * std::cos(e) * std::sin(a),
-                   f.range_m * std::sin(e)};
+          if (f.has_return) f.p = f.range_m * direction;
           truth->push_back(f);
         }
       }
@@ -102,7 +157,7 @@ std::vector<std::uint8_t> SyntheticLidar::packet(int k, std::vector<TruthFiring>
   if (vlp) {
     for (int i = 0; i < 4; ++i) bytes[1200 + i] = static_cast<std::uint8_t>((stamp >> (8 * i)) & 0xFF);
     bytes[1204] = dual ? 0x39 : 0x37;
-    bytes[1205] = 0x22;
+    bytes[1205] = timing.product;
   } else {
     const std::uint8_t magic[8] = {0x55, 0xAA, 0x05, 0x0A, 0x5A, 0xA5, 0x50, 0xA0};
     for (int i = 0; i < 8; ++i) bytes[i] = magic[i];

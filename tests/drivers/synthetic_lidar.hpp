@@ -1,22 +1,26 @@
-// A synthetic spinning 16-beam lidar for the driver tests: writes VLP-16 / RS-16 packets byte by byte from
-// a known scene (written from the manuals' packet layouts, independently of lib/drivers) and returns the
-// ground truth of every firing: time, continuous azimuth, laser, ring, range, intensity and position.
+// A synthetic spinning lidar for the driver tests: writes VLP-16 / RS-16 / VLP-32C / HDL-32E packets byte by
+// byte (written from the manuals' packet layouts and tables, independently of lib/drivers) with random ranges
+// or those of a given scene, and returns the ground truth of every firing: time, continuous azimuth, laser,
+// ring, range, intensity and position.
 #pragma once
 
 #include <Eigen/Core>
 
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 namespace adit::drivers::testing {
 
-enum class Model { kVlp16, kRs16 };
+enum class Model { kVlp16, kRs16, kVlp32c, kHdl32e };
+
+int beamsOf(Model model);
 
 struct TruthFiring {
   std::int64_t t_ns = 0;      // since the first firing of packet 0 (exact; sensor stamps are whole us)
   std::int64_t offset_ns = 0; // since the first firing of its packet
-  double azimuth_deg = 0.0;   // [0, 360)
+  double azimuth_deg = 0.0;   // the head's, [0, 360) (a VLP-32C beam points azimuthOffsetDeg away from it)
   int laser = 0;
   int ring = 0;
   double range_m = 0.0;       // 0 = no return
@@ -30,9 +34,11 @@ struct SyntheticLidar {
   int az0_centideg = 1234;    // azimuth of block 0 of packet 0
   int gap_centideg = 40;      // azimuth advance per firing block (0.40 deg: ~10 Hz)
   std::int64_t stamp0_us = 0; // sensor stamp of packet 0 (VLP-16: us past the hour; RS-16: UTC us)
-  bool dual = false;          // dual-return packets (VLP-16: block pairs; RS-16: both echoes in one block)
+  bool dual = false;          // dual-return packets (Velodyne: block pairs; RS-16: both echoes in one block)
   double no_return_fraction = 0.05;
   std::uint64_t seed = 1;
+  // The scene: range (m) along a beam's unit direction (0 = no return) for the first echo; random if empty.
+  std::function<double(const Eigen::Vector3d&)> scene;
 
   // Packet k of the stream; appends its firings (in packet order) to *truth if given.
   std::vector<std::uint8_t> packet(int k, std::vector<TruthFiring>* truth = nullptr) const;
@@ -44,8 +50,10 @@ struct SyntheticLidar {
   std::int64_t stampUs(int k) const;     // sensor stamp of packet k
 };
 
-// Nominal elevation (deg) and ring of a laser id, from the manuals' tables.
+// Nominal elevation (deg), horizontal offset from the head's azimuth (deg, clockwise; VLP-32C only) and ring
+// (rank of elevation) of a laser id, from the manuals' tables.
 double elevationDeg(Model model, int laser);
+double azimuthOffsetDeg(Model model, int laser);
 int ringOf(Model model, int laser);
 
 // An RS-16 DIFOP packet: return mode byte 300 (0 dual, 1 strongest), vertical angles at 1165 (3 bytes each,

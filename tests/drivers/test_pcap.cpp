@@ -7,9 +7,9 @@
 #include "runtime/source.hpp"
 #include "sources/capture_lidar_reader.hpp"
 #include "sources/pcap_source.hpp"
+#include "pcap_recording.hpp"
 #include "synthetic_lidar.hpp"
 
-#include <adit/lidar_scan_t.hpp>
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -26,136 +26,7 @@ namespace {
 using drivers::testing::Model;
 using drivers::testing::SyntheticLidar;
 using drivers::testing::TruthFiring;
-
-constexpr std::int64_t kHost0Ns = 1700000000LL * 1000000000;  // capture clock at packet 0's first firing
-constexpr std::int64_t kLatencyNs = 100000;                    // last firing -> capture
-constexpr std::uint32_t kSensorIp = 0xC0A801C9, kHostIp = 0xC0A80164, kOtherIp = 0xC0A80105;
-
-struct Recording {
-  int packets = 0;
-  int lost = -1;        // never written
-  int reordered = -1;   // written after packet reordered + 1 (put back in order by the reorder window)
-  int late = -1;        // written kReorderWindow + 2 packets late: beyond the window, skipped
-  int fragmented = -1;  // split into IP fragments of at most 576 bytes
-  bool nanoseconds = false;
-  std::vector<std::uint8_t> difop;  // RS-16: a DIFOP packet captured before the data (port 7788)
-  std::function<void(std::vector<std::uint8_t>&)> mutate;  // rewrites every data packet
-};
-
-std::int64_t captureNs(const SyntheticLidar& lidar, int k) {
-  return kHost0Ns + k * lidar.packetNs() + lidar.lastFiringNs() + kLatencyNs;
-}
-
-std::uint16_t portOf(const SyntheticLidar& lidar) { return lidar.model == Model::kVlp16 ? 2368 : 6699; }
-
-io::UdpDatagram datagram(std::int64_t time_ns, std::uint32_t src, std::uint16_t port, std::vector<std::uint8_t> payload) {
-  io::UdpDatagram d;
-  d.time_ns = time_ns;
-  d.src_ip = src;
-  d.dst_ip = kHostIp;
-  d.src_port = port;
-  d.dst_port = port;
-  d.payload = std::move(payload);
-  return d;
-}
-
-// The capture as tcpdump on the host would have written it, with foreign traffic mixed in: an ARP frame, a
-// VLP-16 position packet (port 8308) and a datagram from another host to the data port.
-std::string writeRecording(const SyntheticLidar& lidar, const Recording& r) {
-  std::ostringstream out;
-  io::PcapWriter pcap(out, r.nanoseconds);
-  std::vector<int> order;
-  for (int k = 0; k < r.packets; ++k)
-    if (k != r.lost) order.push_back(k);
-  if (r.reordered >= 0) {
-    const auto at = std::find(order.begin(), order.end(), r.reordered);
-    std::iter_swap(at, at + 1);
-  }
-  if (r.late >= 0) {
-    order.erase(std::find(order.begin(), order.end(), r.late));
-    order.insert(std::find(order.begin(), order.end(), r.late + static_cast<int>(kReorderWindow) + 2) + 1, r.late);
-  }
-  if (!r.difop.empty()) pcap.writeUdp(datagram(captureNs(lidar, 0) - 1000000, kSensorIp, 7788, r.difop));
-  for (int k : order) {
-    const std::int64_t t = captureNs(lidar, k);
-    std::vector<std::uint8_t> packet = lidar.packet(k);
-    if (r.mutate) r.mutate(packet);
-    pcap.writeUdp(datagram(t, kSensorIp, portOf(lidar), packet), k == r.fragmented ? 576 : 1500);
-    if (k == 3) {
-      std::vector<std::uint8_t> arp(42, 0);
-      arp[12] = 0x08;
-      arp[13] = 0x06;
-      pcap.writeFrame(t + 10, arp);
-      pcap.writeUdp(datagram(t + 20, kSensorIp, 8308, std::vector<std::uint8_t>(512, 7)));
-      pcap.writeUdp(datagram(t + 30, kOtherIp, portOf(lidar), packet));
-    }
-  }
-  return out.str();
-}
-
-drivers::UdpLidarConfig configOf(const SyntheticLidar& lidar) {
-  drivers::UdpLidarConfig c;
-  c.model = lidar.model == Model::kVlp16 ? "vlp16" : "rs16";
-  return c;
-}
-
-struct Decoded {
-  std::vector<LidarScan> sweeps;
-  runtime::Health health;
-};
-
-Decoded decode(const std::string& bytes, const drivers::UdpLidarConfig& config) {
-  std::istringstream in(bytes);
-  CaptureLidarReader reader(in, "test.pcap", config);
-  Decoded d;
-  while (reader.read(d.sweeps)) {
-  }
-  d.health = reader.health();
-  return d;
-}
-
-// Every point of every sweep is a distinct truth return of a packet that was captured, at its time (to the
-// microsecond of the sensor stamps) and position (1 mm), with its ring; and every such return after the first
-// pass of the cut angle is there.
-void expectPointsMatchTruth(const SyntheticLidar& lidar, const Recording& r, const Decoded& d) {
-  struct Truth {
-    TruthFiring f;
-    bool used = false;
-  };
-  std::vector<std::vector<Truth>> by_ring(16);
-  std::size_t expected = 0;
-  for (int k = 0; k < r.packets; ++k) {
-    if (k == r.lost || k == r.late) continue;
-    std::vector<TruthFiring> truth;
-    lidar.packet(k, &truth);
-    for (const TruthFiring& f : truth) {
-      if (!f.has_return) continue;
-      const double unwrapped = (lidar.az0_centideg + lidar.gap_centideg * static_cast<double>(f.t_ns) /
-                                                         static_cast<double>(lidar.blockNs())) / 100.0;
-      if (std::floor((unwrapped - 180.0) / 360.0) > std::floor((lidar.az0_centideg / 100.0 - 180.0) / 360.0)) ++expected;
-      by_ring[static_cast<std::size_t>(f.ring)].push_back({f});
-    }
-  }
-  const std::int64_t anchor = kHost0Ns + kLatencyNs;
-  std::size_t matched = 0;
-  for (const LidarScan& s : d.sweeps) {
-    for (const LidarPoint& p : s.points) {
-      ASSERT_LT(p.ring, 16);
-      const double t = static_cast<double>(s.utime * 1000 - anchor) + static_cast<double>(p.dt) * 1e9;
-      auto& candidates = by_ring[p.ring];
-      auto best = candidates.end();
-      for (auto it = candidates.begin(); it != candidates.end(); ++it)
-        if (!it->used && std::abs(static_cast<double>(it->f.t_ns) - t) < 2500.0 &&
-            (it->f.p - p.p.cast<double>()).norm() < 1e-3)
-          best = it;
-      ASSERT_NE(best, candidates.end()) << "no truth firing of ring " << p.ring << " at " << t << " ns, " << p.p.transpose();
-      best->used = true;
-      EXPECT_EQ(p.intensity, best->f.intensity);
-      ++matched;
-    }
-  }
-  EXPECT_EQ(matched, expected);
-}
+using namespace adit::sources::testing;  // NOLINT(google-build-using-namespace): the shared recording helpers
 
 struct Case {
   const char* name;
@@ -169,7 +40,7 @@ TEST_P(PcapRecording, DecodesToTheKnownFiringsDespiteLossReorderAndFragments) {
   SyntheticLidar lidar;
   lidar.model = GetParam().model;
   lidar.dual = GetParam().dual;
-  lidar.stamp0_us = lidar.model == Model::kVlp16 ? 777777 : drivers::testing::kRs16TestEpochUs + 5;
+  lidar.stamp0_us = lidar.model == Model::kRs16 ? drivers::testing::kRs16TestEpochUs + 5 : 777777;
   Recording r;
   r.packets = static_cast<int>(3.6 * lidar.rotationNs() / static_cast<double>(lidar.packetNs()));
   r.lost = 40;
@@ -182,7 +53,7 @@ TEST_P(PcapRecording, DecodesToTheKnownFiringsDespiteLossReorderAndFragments) {
   ASSERT_EQ(d.sweeps.size(), 4u);
   for (std::size_t j = 0; j < 3; ++j) EXPECT_FALSE(d.sweeps[j].partial);
   EXPECT_TRUE(d.sweeps[3].partial);
-  expectPointsMatchTruth(lidar, r, d);
+  expectPointsMatchTruth(lidar, r, d.sweeps);
   EXPECT_EQ(d.health.inputs, r.packets - 1);  // the lost one
   EXPECT_EQ(d.health.counters.at("reordered"), 1);  // put back in place: nothing skipped
   EXPECT_EQ(d.health.counters.count("time_backwards"), 0u);
@@ -195,7 +66,9 @@ TEST_P(PcapRecording, DecodesToTheKnownFiringsDespiteLossReorderAndFragments) {
 
 INSTANTIATE_TEST_SUITE_P(Sensors, PcapRecording,
                          ::testing::Values(Case{"vlp16", Model::kVlp16, false}, Case{"vlp16_dual", Model::kVlp16, true},
-                                           Case{"rs16", Model::kRs16, false}, Case{"rs16_dual", Model::kRs16, true}),
+                                           Case{"rs16", Model::kRs16, false}, Case{"rs16_dual", Model::kRs16, true},
+                                           Case{"vlp32c", Model::kVlp32c, false}, Case{"vlp32c_dual", Model::kVlp32c, true},
+                                           Case{"hdl32e", Model::kHdl32e, false}),
                          [](const auto& info) { return std::string(info.param.name); });
 
 TEST(PcapRecording, Rs16DifopCalibratedAnglesReplaceTheNominalOnes) {
@@ -225,7 +98,7 @@ TEST(PcapRecording, Rs16DifopCalibratedAnglesReplaceTheNominalOnes) {
   config.vertical_angles_deg.assign(nominal.begin(), nominal.end());
   const Decoded mine = decode(writeRecording(lidar, r), config);
   EXPECT_EQ(mine.health.counters.count("difop_applied"), 0u);
-  expectPointsMatchTruth(lidar, r, mine);
+  expectPointsMatchTruth(lidar, r, mine.sweeps);
 }
 
 TEST(PcapRecording, Vlp16AnnouncingAnotherProductNeedsTheConfigKey) {
@@ -241,7 +114,7 @@ TEST(PcapRecording, Vlp16AnnouncingAnotherProductNeedsTheConfigKey) {
   config.accept_product_ids = {0x24};
   const Decoded accepted = decode(writeRecording(lidar, r), config);
   EXPECT_EQ(accepted.health.counters.count("unknown_product"), 0u);
-  expectPointsMatchTruth(lidar, r, accepted);
+  expectPointsMatchTruth(lidar, r, accepted.sweeps);
 }
 
 TEST(PcapRecording, APacketLaterThanTheReorderWindowIsSkipped) {
@@ -252,7 +125,7 @@ TEST(PcapRecording, APacketLaterThanTheReorderWindowIsSkipped) {
   const Decoded d = decode(writeRecording(lidar, r), configOf(lidar));
   EXPECT_EQ(d.health.counters.at("time_backwards"), 1);
   ASSERT_GE(d.sweeps.size(), 2u);
-  expectPointsMatchTruth(lidar, r, d);
+  expectPointsMatchTruth(lidar, r, d.sweeps);
 }
 
 TEST(PcapRecording, NanosecondFileGivesTheSameSweeps) {
@@ -275,7 +148,7 @@ TEST(PcapRecording, HostTimeUsesTheCaptureTimes) {
   config.time_source = "host";
   const Decoded d = decode(writeRecording(lidar, r), config);
   ASSERT_GE(d.sweeps.size(), 2u);
-  expectPointsMatchTruth(lidar, r, d);
+  expectPointsMatchTruth(lidar, r, d.sweeps);
 }
 
 TEST(PcapRecording, Rs16WithoutAClockFallsBackToCaptureTimes) {
@@ -296,7 +169,7 @@ TEST(PcapRecording, Rs16WithoutAClockFallsBackToCaptureTimes) {
   EXPECT_EQ(d.health.counters.at("host_time_fallback"), 1);
   EXPECT_EQ(d.health.counters.count("bad_timestamp"), 0u);
   ASSERT_GE(d.sweeps.size(), 2u);
-  expectPointsMatchTruth(lidar, r, d);
+  expectPointsMatchTruth(lidar, r, d.sweeps);
 }
 
 TEST(PcapRecording, SensorAddressKeyPicksTheSensor) {
@@ -312,37 +185,54 @@ TEST(PcapRecording, SensorAddressKeyPicksTheSensor) {
   EXPECT_THROW(decode(writeRecording(lidar, r), config), std::invalid_argument);
 }
 
-// The message source the bridge and `adit import pcap` run: compact sweeps, the last one flagged partial.
-TEST(PcapSource, PublishesEncodedSweepsWithThePartialFlag) {
+// The message source the bridge and `adit import pcap` run: compact sweeps (the bus's encoding, decoded back)
+// holding the known firings, ring and time exact, the last one flagged partial. Single-return 16-beam sweeps
+// go in the firing-grid layout (1 mm); a VLP-32C's (each laser has its own horizontal offset, which the grid
+// has no field for) and dual-return ones (two echoes per firing) fall back to the per-point layout, whose
+// promise is msg::sweepTolerance (0.5 range count + 1e-4 rad: 1 cm at 90 m) and times to 1/65535 of the sweep.
+struct SourceCase {
+  const char* name;
+  Model model;
+  bool dual, grid;
+};
+
+class PcapSource : public ::testing::TestWithParam<SourceCase> {};
+
+TEST_P(PcapSource, PublishesEncodedSweepsOfTheKnownFiringsWithThePartialFlag) {
   SyntheticLidar lidar;
+  lidar.model = GetParam().model;
+  lidar.dual = GetParam().dual;
   Recording r;
-  r.packets = 300;
-  const std::string path = ::testing::TempDir() + "adit_pcap_source_" + std::to_string(::getpid()) + ".pcap";
+  r.packets = static_cast<int>(3.6 * lidar.rotationNs() / static_cast<double>(lidar.packetNs()));
+  r.lost = 40;
+  r.fragmented = 150;
+  const std::string path = ::testing::TempDir() + "adit_pcap_source_" + GetParam().name + "_" + std::to_string(::getpid()) + ".pcap";
   {
     std::ofstream f(path, std::ios::binary);
     f << writeRecording(lidar, r);
   }
   auto source = makePcapLidarSource(path, configOf(lidar));
-  runtime::OutgoingMessage m;
-  std::vector<LidarScan> sweeps;
-  std::int64_t last_utime = 0;
-  while (source->next(m)) {
-    EXPECT_EQ(m.channel, "LIDAR_POINTS");
-    EXPECT_GT(m.utime, last_utime);
-    last_utime = m.utime;
-    adit::lidar_scan_t msg;
-    ASSERT_GT(msg.decode(m.data.data(), 0, static_cast<int>(m.data.size())), 0);
-    LidarScan scan;
-    ASSERT_EQ(msg::decodeSweep(msg, scan), "");
-    sweeps.push_back(std::move(scan));
-  }
+  const std::vector<LidarScan> sweeps = publishedSweeps(*source);
   std::remove(path.c_str());
   ASSERT_EQ(sweeps.size(), 4u);
   EXPECT_FALSE(sweeps[2].partial);
   EXPECT_TRUE(sweeps[3].partial);
-  EXPECT_GT(sweeps[1].points.size(), 20000u);
+  EXPECT_EQ(sweeps[1].num_beams, drivers::testing::beamsOf(lidar.model));
+  Tolerance tolerance;  // 1 mm, the stamps' microsecond
+  if (!GetParam().grid) {
+    tolerance.position_m = [](double range) { return msg::sweepTolerance(range, msg::kRangeScale); };
+    tolerance.time_ns += 0.5 * 0.1e9 / 65535;  // and half a time count (1/65535 of a sweep of <= 0.1 s)
+  }
+  expectPointsMatchTruth(lidar, r, sweeps, tolerance);
   EXPECT_DOUBLE_EQ(source->progress(), 1.0);
 }
+
+INSTANTIATE_TEST_SUITE_P(Sensors, PcapSource,
+                         ::testing::Values(SourceCase{"vlp16", Model::kVlp16, false, true},
+                                           SourceCase{"vlp16_dual", Model::kVlp16, true, false},
+                                           SourceCase{"vlp32c", Model::kVlp32c, false, false},
+                                           SourceCase{"vlp32c_dual", Model::kVlp32c, true, false}),
+                         [](const auto& info) { return std::string(info.param.name); });
 
 }  // namespace
 }  // namespace adit::sources

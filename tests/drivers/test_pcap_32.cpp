@@ -4,6 +4,7 @@
 // stream: every point at its firing's position (1 mm), ring (rank of elevation) and time (stamp microsecond).
 #include "io/capture_writer.hpp"
 #include "sources/capture_lidar_reader.hpp"
+#include "synthetic_lidar.hpp"
 
 #include <gtest/gtest.h>
 
@@ -24,25 +25,19 @@ struct Head {
   std::uint8_t product;
 };
 
-Head vlp32c() {
-  // VLP-32C User Manual tables 9-2 / 9-5: laser id -> elevation, and delta.
-  return {"vlp32c",
-          {-25, -1, -1.667, -15.639, -11.31, 0, -0.667, -8.843, -7.254, 0.333, -0.333, -6.148, -5.333, 1.333, 0.667, -4,
-           -4.667, 1.667, 1, -3.667, -3.333, 3.333, 2.333, -2.667, -3, 7, 4.667, -2.333, -2, 15, 10.333, -1.333},
-          {1.4, -4.2, 1.4, -1.4, 1.4, -1.4, 4.2, -1.4, 1.4, -4.2, 1.4, -1.4, 4.2, -1.4, 4.2, -1.4,
-           1.4, -4.2, 1.4, -4.2, 4.2, -1.4, 1.4, -1.4, 1.4, -1.4, 1.4, -4.2, 4.2, -1.4, 1.4, -1.4},
-          55296, 2304, 2, 0.004, 0x28};
-}
-
-Head hdl32e() {
-  Head h{"hdl32e", {}, std::vector<double>(32, 0.0), 46080, 1152, 1, 0.002, 0x21};
-  const double low[16] = {-30.67, -29.33, -28.00, -26.67, -25.33, -24.00, -22.67, -21.33,
-                          -20.00, -18.67, -17.33, -16.00, -14.67, -13.33, -12.00, -10.67};
-  const double high[16] = {-9.33, -8.00, -6.67, -5.33, -4.00, -2.67, -1.33, 0.00,
-                           1.33,  2.67,  4.00,  5.33,  6.67,  8.00,  9.33,  10.67};
-  for (int i = 0; i < 32; ++i) h.elevation.push_back(i % 2 == 0 ? low[i / 2] : high[i / 2]);
+// The manuals' tables (VLP-32C 63-9325 tables 9-2 / 9-5, HDL-32E 63-9113), as the synthetic lidar has them.
+Head headOf(const char* name, drivers::testing::Model model, std::int64_t sequence_ns, std::int64_t pair_ns,
+            int lasers_per_slot, double unit_m, std::uint8_t product) {
+  Head h{name, {}, {}, sequence_ns, pair_ns, lasers_per_slot, unit_m, product};
+  for (int i = 0; i < 32; ++i) {
+    h.elevation.push_back(drivers::testing::elevationDeg(model, i));
+    h.delta.push_back(drivers::testing::azimuthOffsetDeg(model, i));
+  }
   return h;
 }
+
+Head vlp32c() { return headOf("vlp32c", drivers::testing::Model::kVlp32c, 55296, 2304, 2, 0.004, 0x28); }
+Head hdl32e() { return headOf("hdl32e", drivers::testing::Model::kHdl32e, 46080, 1152, 1, 0.002, 0x21); }
 
 struct Truth {
   std::int64_t t_ns;

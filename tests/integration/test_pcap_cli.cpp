@@ -15,9 +15,11 @@
 #include <algorithm>
 #include <cmath>
 #include <sstream>
+#include <utility>
 
 namespace fs = std::filesystem;
 using namespace adit::test;
+using adit::drivers::testing::Model;
 using adit::drivers::testing::SyntheticLidar;
 using adit::drivers::testing::TruthFiring;
 
@@ -149,6 +151,39 @@ TEST_F(PcapCli, BridgePublishesTheSweepsOfTheCapture) {
   ASSERT_TRUE(p.count("LIDAR_POINTS")) << slurp(dir_ / "bridge.txt");
   EXPECT_EQ(p.at("LIDAR_POINTS"), payloads(imported.string()).at("LIDAR_POINTS"));
   EXPECT_GE(p.count("STATUS_LIDAR_BRIDGE") ? p.at("STATUS_LIDAR_BRIDGE").size() : 0u, 1u);
+}
+
+// The 32-beam heads go the same way: `adit import pcap --sensor vlp32c|hdl32e`, and the bridge given only the
+// sensor's launch/sensors file, give every revolution's returns as 32-beam sweeps.
+TEST_F(PcapCli, ThirtyTwoBeamHeadsImportAndBridge) {
+  for (const auto& [name, model] : {std::pair{"vlp32c", Model::kVlp32c}, std::pair{"hdl32e", Model::kHdl32e}}) {
+    SyntheticLidar lidar;
+    lidar.model = model;
+    const fs::path capture = dir_ / (std::string(name) + ".pcap"), log = dir_ / (std::string(name) + ".lcmlog"),
+                   published = dir_ / (std::string(name) + "_bridge.lcmlog");
+    std::ofstream(capture, std::ios::binary) << writeCapture(lidar);
+    ASSERT_EQ(run(bin("adit") + " import pcap " + capture.string() + " --sensor " + name + " -o " + log.string(),
+                  dir_ / "import32.txt"),
+              0)
+        << slurp(dir_ / "import32.txt");
+    const std::vector<std::size_t> returns = returnsPerRevolution(lidar);
+    const auto sweeps = payloads(log.string()).at("LIDAR_POINTS");
+    ASSERT_EQ(sweeps.size(), returns.size() - 1) << name;
+    for (std::size_t j = 0; j < sweeps.size(); ++j) {
+      const adit::LidarScan s = decoded(sweeps[j]);
+      EXPECT_EQ(s.num_beams, 32) << name;
+      EXPECT_EQ(s.sensor, name);
+      EXPECT_EQ(s.points.size(), returns[j + 1]) << name << " sweep " << j;
+    }
+    // No --sensor: the sensor file's lidar_driver.model says which head sent the packets.
+    ASSERT_EQ(run(bin("adit-lidar-bridge") + " --source pcap --path " + capture.string() +
+                      " --driver-config " + ADIT_SOURCE_DIR + "/launch/sensors/" + name + ".yaml --rate 0 --lcm-url 'file://" +
+                      published.string() + "?mode=w'",
+                  dir_ / "bridge32.txt"),
+              0)
+        << slurp(dir_ / "bridge32.txt");
+    EXPECT_EQ(payloads(published.string()).at("LIDAR_POINTS"), sweeps) << name;
+  }
 }
 
 // The simulator's capture and bag are files the other commands read: `adit info` lists the bag's topics with

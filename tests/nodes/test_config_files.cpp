@@ -3,6 +3,7 @@
 // every reader of its sections (pipeline validation, lidar driver, simulator, launcher).
 #include "core/config.hpp"
 #include "drivers/udp_lidar_source.hpp"
+#include "features/feature_config.hpp"
 #include "launch/launch_file.hpp"
 #include "nodes/node_config.hpp"
 #include "nodes/registry.hpp"
@@ -53,18 +54,26 @@ TEST(ConfigFiles, PipelineYamlListsEveryKeyWithItsDefault) {
   EXPECT_GT(defaults.size(), 130u);  // all four stages and their nodes
 }
 
+// A sensor file that names a driver model gives the feature stage that model's ring count.
 TEST(ConfigFiles, SensorAndVariantFilesLoad) {
-  int files = 0;
+  std::set<std::string> names;
   for (const fs::path& dir : {kLaunch / "sensors", kLaunch / "config"}) {
     for (const auto& path : yamlFiles(dir)) {
-      ++files;
+      names.insert(path.filename().string());
       const auto c = adit::Config::fromYamlFile(path.string());
       EXPECT_NO_THROW(adit::nodes::validatePipelineConfig(c)) << path.filename();
       EXPECT_NO_THROW(adit::nodes::makeNode("feature", c)) << path.filename();
-      EXPECT_NO_THROW(adit::drivers::udpLidarConfigFrom(c)) << path.filename();
+      adit::drivers::UdpLidarConfig driver;
+      EXPECT_NO_THROW(driver = adit::drivers::udpLidarConfigFrom(c)) << path.filename();
+      adit::drivers::LidarStreamConfig stream;
+      EXPECT_NO_THROW(stream = adit::drivers::streamConfigOf(driver)) << path.filename();
+      if (c.has("lidar_driver.model"))
+        EXPECT_EQ(adit::featureConfigFrom(c).preprocess.num_rings, stream.sweep.num_beams) << path.filename();
     }
   }
-  EXPECT_GE(files, 6);
+  for (const char* sensor : {"vlp16.yaml", "rs16.yaml", "vlp32c.yaml", "hdl32e.yaml", "hdl64.yaml", "sim.yaml"})
+    EXPECT_TRUE(names.count(sensor)) << "launch/sensors/" << sensor << " is missing";
+  EXPECT_GE(names.size(), 8u);
 }
 
 TEST(ConfigFiles, WorldFilesLoadInTheSimulatorAndPassThePipeline) {
