@@ -67,8 +67,9 @@ TEST(ConfigFiles, SensorAndVariantFilesLoad) {
       EXPECT_NO_THROW(driver = adit::drivers::udpLidarConfigFrom(c)) << path.filename();
       adit::drivers::LidarStreamConfig stream;
       EXPECT_NO_THROW(stream = adit::drivers::streamConfigOf(driver)) << path.filename();
-      if (c.has("lidar_driver.model"))
+      if (c.has("lidar_driver.model")) {
         EXPECT_EQ(adit::featureConfigFrom(c).preprocess.num_rings, stream.sweep.num_beams) << path.filename();
+      }
     }
   }
   for (const char* sensor : {"vlp16.yaml", "rs16.yaml", "vlp32c.yaml", "hdl32e.yaml", "hdl64.yaml", "sim.yaml"})
