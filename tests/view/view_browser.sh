@@ -2,7 +2,8 @@
 # adit view end to end in a real browser: a short simulated run (sensor log, replay products with MAP_UPDATE,
 # STATUS from the feature process run on the log) served by `adit view --log`; Debian's chromium (headless)
 # opens the page and the page's own state (window.aditState) must show the map, the trajectory and the STATUS
-# rows that the logs hold; a screenshot goes to WORK_DIR/view.png. Also: an unknown path is a 404.
+# rows that the logs hold, and the speed menu the server's --speed; a screenshot goes to WORK_DIR/view.png.
+# Also: an unknown path is a 404.
 # Skipped (77) without chromium, node/npm, or the npm packages.
 #   view_browser.sh BIN_DIR SOURCE_DIR WORK_DIR
 set -euo pipefail
@@ -41,6 +42,7 @@ need(s.trajectory.ground_truth > 10, "ground truth trajectory");
 const feature = s.status.find((r) => r.process === "feature");
 need(feature && feature.inputs > 0, "no STATUS row for the feature process");
 need(s.page_errors.length === 0, "page errors");
+need(s.speed_menu === "4", `the speed menu shows ${s.speed_menu}, not the --speed 4 of the server`);
 console.log(`view_browser: ${s.map_points} map points in ${s.submaps} submaps, ${s.trajectory.odometry} of ${poses} poses, ` +
   `${s.status.length} STATUS row(s), ${s.frames} frames, ${(s.bytes / 1e6).toFixed(2)} MB, frame time ${s.frame_ms.toFixed(1)} ms`);
 ' "$work"/state.json "$poses"

@@ -203,7 +203,21 @@ function showInfo(info) {
     if (!slider.matches(":active")) slider.value = info.log.position_s;
     $("time").textContent = `${info.log.position_s.toFixed(1)} / ${info.log.duration_s.toFixed(1)} s`;
     $("play").textContent = info.log.playing ? "pause" : "play";
+    showSpeed(info.log.speed);
   }
+}
+
+// The speed menu shows the server's speed (adit view --speed 20, or another page's choice), with an entry
+// added for a speed the menu lacks; left alone while the operator has the menu open.
+function showSpeed(speed) {
+  const menu = $("speed"), value = String(speed);
+  if (document.activeElement === menu || menu.value === value) return;
+  if (![...menu.options].some((o) => o.value === value)) {
+    const option = new Option(value);
+    const after = [...menu.options].find((o) => Number(o.value) > speed);
+    menu.add(option, after || null);
+  }
+  menu.value = value;
 }
 
 // --- stream -------------------------------------------------------------------------------------------------

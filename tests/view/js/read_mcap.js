@@ -52,7 +52,8 @@ async function main() {
   const topics = {};
   for (const channel of reader.channelsById.values()) {
     const schema = reader.schemasById.get(channel.schemaId);
-    topics[channel.topic] = { schema: schema ? schema.name : "", encoding: channel.messageEncoding, count: 0, last: null };
+    topics[channel.topic] = { schema: schema ? schema.name : "", schema_encoding: schema ? schema.encoding : "",
+                              encoding: channel.messageEncoding, count: 0, last: null };
   }
   let lastLogTime = -1n;
   for await (const message of reader.readMessages({ validateCrcs: true })) {
@@ -99,7 +100,7 @@ async function main() {
 
   const summary = { chunks: reader.chunkIndexes.length, messages: total, compression: [...new Set(reader.chunkIndexes.map((c) => c.compression))], topics: {} };
   for (const [topic, t] of Object.entries(topics)) {
-    const out = { schema: t.schema, encoding: t.encoding, count: t.count };
+    const out = { schema: t.schema, schema_encoding: t.schema_encoding, encoding: t.encoding, count: t.count };
     const last = t.last;
     if (last && last.point_stride) out.last_points = Buffer.from(last.data, "base64").length / last.point_stride;
     if (last && last.poses) {

@@ -52,6 +52,7 @@ async function main() {
     await new Promise((r) => setTimeout(r, 1500));  // a few more frames drawn
     const state = await page.evaluate(() => JSON.parse(JSON.stringify(window.aditState)));
     state.page_errors = errors;
+    state.speed_menu = await page.$eval("#speed", (el) => el.value);  // what the playback speed menu shows
     if (measured) state.measured = measured;
     await page.screenshot({ path: screenshot });
     console.log(JSON.stringify(state));
