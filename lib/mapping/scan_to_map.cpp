@@ -87,9 +87,7 @@ Correspondences ScanToMapMapper::match(const std::vector<Eigen::Vector3d>& corne
       if (const auto line = fitLine(near, config_.line_eigen_ratio)) return LineMatch{corners[i], line->centroid, line->direction};
       return std::nullopt;
     };
-    const Eigen::Vector3d q = T * corners[i];
-    if (reuse) reuse->line(i, q, lines, search);
-    else if (const auto m = search(q)) lines.push_back(*m);
+    addMatch(reuse, i, T * corners[i], lines, search);
   };
   const auto add_plane = [&](std::size_t i, std::vector<PlaneMatch>& planes) {
     const auto search = [&](const Eigen::Vector3d& q) -> std::optional<PlaneMatch> {
@@ -102,9 +100,7 @@ Correspondences ScanToMapMapper::match(const std::vector<Eigen::Vector3d>& corne
       const double offset = config_.plane_through_nearest ? -plane->normal.dot(near.front()) : plane->offset;
       return PlaneMatch{surfs[i], plane->normal, offset};
     };
-    const Eigen::Vector3d q = T * surfs[i];
-    if (reuse) reuse->plane(i, q, planes, search);
-    else if (const auto m = search(q)) planes.push_back(*m);
+    addMatch(reuse, i, T * surfs[i], planes, search);
   };
   return matchInChunks(pool_.get(), corners.size(), surfs.size(), add_line, add_plane);
 }

@@ -236,8 +236,7 @@ Correspondences ScanToScanOdometry::match(const std::vector<LidarPoint>& sharp, 
       if (const auto line = fitLocalLine(at, max_sq)) return LineMatch{p, line->centroid, line->direction};
       return std::nullopt;
     };
-    if (reuse) reuse->line(i, q, lines, search);
-    else if (const auto m = search(q)) lines.push_back(*m);
+    addMatch(reuse, i, q, lines, search);
   };
   const auto add_plane = [&](std::size_t i, std::vector<PlaneMatch>& planes) {
     if (!flat[i].p.allFinite()) return;
@@ -246,8 +245,7 @@ Correspondences ScanToScanOdometry::match(const std::vector<LidarPoint>& sharp, 
       if (const auto plane = fitLocalPlane(at, max_sq)) return PlaneMatch{p, plane->normal, plane->offset};
       return std::nullopt;
     };
-    if (reuse) reuse->plane(i, q, planes, search);
-    else if (const auto m = search(q)) planes.push_back(*m);
+    addMatch(reuse, i, q, planes, search);
   };
   return matchInChunks(pool_.get(), sharp.size(), flat.size(), add_line, add_plane);
 }

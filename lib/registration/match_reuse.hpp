@@ -31,11 +31,11 @@ class MatchReuse {
   // search(q) -> std::optional<LineMatch> (or PlaneMatch): the match of query i at its position q in the
   // reference frame. The result, fresh or kept, is appended to `out` if there is one.
   template <class Search>
-  void line(std::size_t i, const Eigen::Vector3d& q, std::vector<LineMatch>& out, const Search& search) {
+  void add(std::size_t i, const Eigen::Vector3d& q, std::vector<LineMatch>& out, const Search& search) {
     lookup(lines_[i], q, out, search);
   }
   template <class Search>
-  void plane(std::size_t i, const Eigen::Vector3d& q, std::vector<PlaneMatch>& out, const Search& search) {
+  void add(std::size_t i, const Eigen::Vector3d& q, std::vector<PlaneMatch>& out, const Search& search) {
     lookup(planes_[i], q, out, search);
   }
 
@@ -75,5 +75,12 @@ class MatchReuse {
   std::vector<Slot<LineMatch>> lines_;
   std::vector<Slot<PlaneMatch>> planes_;
 };
+
+// Query i's match appended to `out`: kept across rounds by `reuse`, or searched afresh when reuse is nullptr.
+template <class Match, class Search>
+void addMatch(MatchReuse* reuse, std::size_t i, const Eigen::Vector3d& q, std::vector<Match>& out, const Search& search) {
+  if (reuse) reuse->add(i, q, out, search);
+  else if (const std::optional<Match> m = search(q)) out.push_back(*m);
+}
 
 }  // namespace adit

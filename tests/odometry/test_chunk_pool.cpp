@@ -82,11 +82,11 @@ TEST(MatchReuse, KeepsAMatchWhileItsQueryStaysWithinTheTolerance) {
     return PlaneMatch{Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitX(), -q.x()};
   };
   std::vector<PlaneMatch> out;
-  reuse.plane(0, Eigen::Vector3d(1, 0, 0), out, search);
-  reuse.plane(0, Eigen::Vector3d(1.019, 0, 0), out, search);  // moved 19 mm: kept
-  reuse.plane(0, Eigen::Vector3d(1.0, 0.015, 0.0), out, search);  // measured from where it was searched: kept
-  reuse.plane(0, Eigen::Vector3d(1.021, 0, 0), out, search);  // 21 mm: searched again
-  reuse.plane(0, Eigen::Vector3d(1.03, 0, 0), out, search);   // 9 mm from the new search: kept
+  reuse.add(0, Eigen::Vector3d(1, 0, 0), out, search);
+  reuse.add(0, Eigen::Vector3d(1.019, 0, 0), out, search);  // moved 19 mm: kept
+  reuse.add(0, Eigen::Vector3d(1.0, 0.015, 0.0), out, search);  // measured from where it was searched: kept
+  reuse.add(0, Eigen::Vector3d(1.021, 0, 0), out, search);  // 21 mm: searched again
+  reuse.add(0, Eigen::Vector3d(1.03, 0, 0), out, search);   // 9 mm from the new search: kept
   ASSERT_EQ(out.size(), 5u);
   EXPECT_EQ(searches, 2);
   EXPECT_EQ(out[0].offset, -1.0);
@@ -107,12 +107,12 @@ TEST(MatchReuse, RemembersThatAQueryFoundNothingAndKeepsQueriesApart) {
     return LineMatch{q, q, Eigen::Vector3d::UnitZ()};
   };
   std::vector<LineMatch> out;
-  reuse.line(0, Eigen::Vector3d::Zero(), out, none);
-  reuse.line(1, Eigen::Vector3d::Zero(), out, found);  // another query at the same place: its own search
-  reuse.line(0, Eigen::Vector3d(0.01, 0, 0), out, found);  // still "nothing": not searched again
+  reuse.add(0, Eigen::Vector3d::Zero(), out, none);
+  reuse.add(1, Eigen::Vector3d::Zero(), out, found);  // another query at the same place: its own search
+  reuse.add(0, Eigen::Vector3d(0.01, 0, 0), out, found);  // still "nothing": not searched again
   EXPECT_EQ(searches, 2);
   ASSERT_EQ(out.size(), 1u);
-  reuse.line(0, Eigen::Vector3d(0.06, 0, 0), out, found);  // moved away: searched, and now it matches
+  reuse.add(0, Eigen::Vector3d(0.06, 0, 0), out, found);  // moved away: searched, and now it matches
   EXPECT_EQ(searches, 3);
   EXPECT_EQ(out.size(), 2u);
 }
@@ -122,11 +122,11 @@ TEST(MatchReuse, ZeroToleranceSearchesEveryTimeAndNonFiniteQueriesAreSearched) {
   int searches = 0;
   const auto search = [&](const Eigen::Vector3d&) -> std::optional<PlaneMatch> { ++searches; return std::nullopt; };
   std::vector<PlaneMatch> out;
-  for (int i = 0; i < 3; ++i) reuse.plane(0, Eigen::Vector3d(1, 2, 3), out, search);
+  for (int i = 0; i < 3; ++i) reuse.add(0, Eigen::Vector3d(1, 2, 3), out, search);
   EXPECT_EQ(searches, 3);
   MatchReuse nan(0, 1, 1.0);
   const Eigen::Vector3d bad = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
-  for (int i = 0; i < 2; ++i) nan.plane(0, bad, out, search);
+  for (int i = 0; i < 2; ++i) nan.add(0, bad, out, search);
   EXPECT_EQ(searches, 5) << "a NaN position is never 'within the tolerance'";
 }
 
