@@ -288,13 +288,19 @@ std::optional<Relocaliser::Fix> Relocaliser::bestFix(const PoseEstimate& session
 // robot stands at is outside the mapped part: the map then holds one copy, and the fit to it is unambiguous
 // (room-and-pillar: starts outside a 167 m map fixed 120 m off, turned 180 deg). Checked once per keyframe.
 bool Relocaliser::selfSimilar(const Eigen::Isometry3d& T_map_lidar) {
-  int m = -1;
-  double nearest = 1e18;
-  for (std::size_t k = 0; k < bundle_.keyframes.size(); ++k) {
-    const double d = (bundle_.keyframes[k].pose.translation() - T_map_lidar.translation()).squaredNorm();
-    if (d < nearest) nearest = d, m = static_cast<int>(k);
-  }
+  const int m = nearestKeyframe(T_map_lidar.translation());
   return m >= 0 && keyframeSelfSimilar(m);
+}
+
+// The bundle keyframe nearest a map position; -1 for an empty bundle.
+int Relocaliser::nearestKeyframe(const Eigen::Vector3d& position) const {
+  int nearest = -1;
+  double best = 1e18;
+  for (std::size_t k = 0; k < bundle_.keyframes.size(); ++k) {
+    const double d = (bundle_.keyframes[k].pose.translation() - position).squaredNorm();
+    if (d < best) best = d, nearest = static_cast<int>(k);
+  }
+  return nearest;
 }
 
 // The share of keyframes spread evenly over the map that repeat elsewhere in it, against
@@ -383,12 +389,7 @@ void Relocaliser::track(const PoseEstimate& session) {
   if (travelled_ - last_query_travelled_ < config_.track_distance) return;
   last_query_travelled_ = travelled_;
   const Eigen::Isometry3d predicted = T_map_session_ * session.pose;
-  int nearest = -1;
-  double best = 1e18;
-  for (std::size_t k = 0; k < bundle_.keyframes.size(); ++k) {
-    const double d = (bundle_.keyframes[k].pose.translation() - predicted.translation()).squaredNorm();
-    if (d < best) best = d, nearest = static_cast<int>(k);
-  }
+  const int nearest = nearestKeyframe(predicted.translation());
   bool ok = false;
   if (nearest >= 0) {
     const Eigen::Isometry3d& match = bundle_.keyframes[static_cast<std::size_t>(nearest)].pose;

@@ -53,8 +53,8 @@ struct RelocaliserConfig {
   // relocalising query, also fits tightly somewhere else. A pillar grid or a run of identical cross-cuts is
   // locally the same from many places, and a robot outside the mapped part sees the same as one inside it.
   // A map most of whose places repeat (a regular pillar grid: every place there has a twin, mapped or not)
-  // cannot place a robot that may have started outside it: every fix is refused. Judged on the first
-  // candidate fix from self_similar_samples keyframes spread over the map.
+  // cannot place a robot that may have started outside it: every fix is refused. Judged from
+  // self_similar_samples keyframes spread over the map, on a thread started when the bundle is loaded.
   bool refuse_self_similar = true;
   int self_similar_candidates = 100;  // Scan Context candidates ranked when looking for the keyframe's alias
   int self_similar_samples = 12;      // keyframes checked to judge the whole map
@@ -139,6 +139,7 @@ class Relocaliser {
                           const Eigen::Isometry3d& seed, AxialSearchResult& search, RelocStats& stats) const;
   bool consistent(const Fix& a, const Fix& b) const;
   bool selfSimilar(const Eigen::Isometry3d& T_map_lidar);
+  int nearestKeyframe(const Eigen::Vector3d& position) const;
   bool keyframeSelfSimilar(int keyframe);
   bool repeatsElsewhere(int keyframe, RelocStats& stats) const;  // reads only the bundle: safe on any thread
   struct MapJudgement {
