@@ -1,6 +1,9 @@
 #include "runtime/allocator.hpp"
 
 #include <malloc.h>
+#include <unistd.h>
+
+#include <fstream>
 
 namespace adit::runtime {
 
@@ -10,6 +13,18 @@ void keepFreedMemoryForReuse() {
   // not depend on what was freed first.
   mallopt(M_MMAP_THRESHOLD, 64 << 20);
   mallopt(M_TRIM_THRESHOLD, 256 << 20);
+}
+
+MemoryUse returnFreeMemory() {
+  MemoryUse use;
+  const struct mallinfo2 info = mallinfo2();
+  use.heap_in_use_kb = static_cast<std::int64_t>((info.uordblks + info.hblkhd) / 1024);
+  use.heap_free_kb = static_cast<std::int64_t>(info.fordblks / 1024);
+  malloc_trim(0);
+  std::ifstream statm("/proc/self/statm");
+  std::int64_t pages = 0, resident = 0;
+  if (statm >> pages >> resident) use.resident_kb = resident * (sysconf(_SC_PAGESIZE) / 1024);
+  return use;
 }
 
 }  // namespace adit::runtime

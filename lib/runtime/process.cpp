@@ -194,6 +194,9 @@ int runNodeProcess(int argc, char** argv, const std::string& name, const std::st
   const std::string status_channel = options.status_channel.empty() ? statusChannel(name) : options.status_channel;
   const auto start = std::chrono::steady_clock::now();
   auto last_status = start;
+  auto last_trim = start;
+  MemoryUse memory = returnFreeMemory();
+  constexpr std::chrono::seconds kReturnFreeMemoryPeriod{30};  // runtime/allocator.hpp
   std::int64_t status_seq = 0, inputs_at_last_status = 0;
   double busy_at_last_status = 0;
   // A stage busy this share of the time cannot keep up: its socket buffer fills and sweeps get lost.
@@ -208,6 +211,7 @@ int runNodeProcess(int argc, char** argv, const std::string& name, const std::st
     if (reported == "behind") spdlog::warn("busy {:.0f}% of the time: falling behind its input", busy * 100);
     adit::status_t status = makeStatus(*node, wallUtime(), status_seq++,
                                        std::chrono::duration<double>(now - start).count(), rate, busy, reported);
+    addMemoryCounters(status, memory);
     traffic.report(status, window);
     if (probe) probe->report(status);
     const Bytes bytes = msg::encode(status);
@@ -228,6 +232,10 @@ int runNodeProcess(int argc, char** argv, const std::string& name, const std::st
     }
     if (std::chrono::steady_clock::now() - last_status >= std::chrono::duration<double>(options.status_period_s))
       sendStatus(node->state());
+    if (std::chrono::steady_clock::now() - last_trim >= kReturnFreeMemoryPeriod) {
+      memory = returnFreeMemory();
+      last_trim = std::chrono::steady_clock::now();
+    }
   }
   node->finish(sink);
   sendStatus("stopping");

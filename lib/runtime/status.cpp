@@ -79,4 +79,15 @@ void addLatencyCounters(adit::status_t& status, const std::string& name, const L
   status.num_counters = static_cast<std::int32_t>(status.counter_names.size());
 }
 
+void addMemoryCounters(adit::status_t& status, const MemoryUse& memory) {
+  const std::pair<const char*, std::int64_t> fields[] = {{"memory_resident_kb", memory.resident_kb},
+                                                         {"memory_heap_in_use_kb", memory.heap_in_use_kb},
+                                                         {"memory_heap_free_kb", memory.heap_free_kb}};
+  for (const auto& [name, value] : fields) {
+    status.counter_names.push_back(name);
+    status.counter_values.push_back(value);
+  }
+  status.num_counters = static_cast<std::int32_t>(status.counter_names.size());
+}
+
 }  // namespace adit::runtime

@@ -1,6 +1,7 @@
 // Builds the STATUS message of a node.
 #pragma once
 
+#include "runtime/allocator.hpp"
 #include "runtime/latency.hpp"
 #include "runtime/node.hpp"
 
@@ -43,5 +44,9 @@ adit::status_t makeStatus(const std::string& process, const Health& health, cons
 // Appends a latency summary to status's named counters, in microseconds: "<name>_p50_us", "_p95_us",
 // "_p99_us", "_max_us", and "<name>_samples" (sweeps in the window), "<name>_unmatched" (never completed).
 void addLatencyCounters(adit::status_t& status, const std::string& name, const LatencySummary& latency);
+
+// Appends the process's memory (runtime/allocator.hpp, last measured) to status's named counters:
+// "memory_resident_kb", "memory_heap_in_use_kb", "memory_heap_free_kb".
+void addMemoryCounters(adit::status_t& status, const MemoryUse& memory);
 
 }  // namespace adit::runtime
