@@ -2,9 +2,11 @@
 # Soak benchmark (not a CI test): the simulated live run (launch/sim.launch.yaml: simulator + four stage
 # processes + recorder) for a long time in a private network namespace, sampling the resident memory, peak
 # memory, threads and open file descriptors of every process, to show that nothing grows without bound.
-#   scripts/soak.sh [--duration S] [--world W] [--interval S] [-o DIR]
-# Defaults: 7200 s (2 hours), roadway-loop, a sample every 10 s, output in logs/soak-<time>/. Writes
-# samples.csv (t_s,process,pid,rss_mb,hwm_mb,threads,fds) and prints a summary per process: peak RSS (VmHWM),
+#   scripts/soak.sh [--duration S] [--world W] [--interval S] [--rate R] [-o DIR]
+# Defaults: 7200 s (2 hours), roadway-loop, a sample every 10 s, output in logs/soak-<time>/. --rate R simulates
+# at R times real time (the stages keep up with 2 on a quiet 2-core machine): DURATION seconds of sensor time in
+# DURATION / R of wall time. Writes samples.csv (t_s,process,pid,rss_mb,hwm_mb,threads,fds; t_s in seconds of
+# sensor time, i.e. wall seconds x R) and prints a summary per process: peak RSS (VmHWM),
 # RSS at 5 minutes and at the end, growth after the first 5 minutes in MB per hour, fds and threads min/max,
 # restarts (pid changes). `scripts/soak.sh --summary samples.csv` prints the summary of an earlier run.
 # Only STATUS is recorded (the sensor data would be ~6 MB/s). Run it niced on a shared machine.
@@ -28,32 +30,34 @@ summarise() {  # samples.csv -> one line per process
       printf "%-18s %8d %9.1f %9.1f %9.1f %12.1f %4d-%-4d %4d-%-4d %8d\n", k, n[k], hwm[k], r5[k], last[k], g, fmin[k], fmax[k], tmin[k], tmax[k], restarts[k] + 0 }
   }' "$1"
 }
-DURATION=7200 WORLD=roadway-loop INTERVAL=10 OUT=
+DURATION=7200 WORLD=roadway-loop INTERVAL=10 RATE=1 OUT=
 while [ $# -gt 0 ]; do
   case $1 in
     --duration) DURATION=$2; shift 2 ;;
     --world) WORLD=$2; shift 2 ;;
     --interval) INTERVAL=$2; shift 2 ;;
+    --rate) RATE=$2; shift 2 ;;
     -o) OUT=$2; shift 2 ;;
     --summary) summarise "$2"; exit 0 ;;
-    *) echo "usage: scripts/soak.sh [--duration S] [--world W] [--interval S] [-o DIR]" >&2; exit 2 ;;
+    *) echo "usage: scripts/soak.sh [--duration S] [--world W] [--interval S] [--rate R] [-o DIR]" >&2; exit 2 ;;
   esac
 done
 OUT=${OUT:-$ROOT/logs/soak-$(date +%Y%m%d-%H%M%S)}
 if [ -z "${ADIT_IN_NETNS:-}" ]; then
   mkdir -p "$OUT"
-  exec bash "$ROOT/tests/integration/netns.sh" bash "$0" --duration "$DURATION" --world "$WORLD" --interval "$INTERVAL" -o "$OUT"
+  exec bash "$ROOT/tests/integration/netns.sh" bash "$0" --duration "$DURATION" --world "$WORLD" --interval "$INTERVAL" --rate "$RATE" -o "$OUT"
 fi
 BIN=$ROOT/build/bin
-"$BIN/adit" launch "$ROOT/launch/sim.launch.yaml" --set WORLD="$WORLD" --set DURATION="$DURATION" \
+"$BIN/adit" launch "$ROOT/launch/sim.launch.yaml" --set WORLD="$WORLD" --set DURATION="$DURATION" --set RATE="$RATE" \
   --set 'RECORD=^STATUS_.*$' --log-dir "$OUT" --quiet > "$OUT/launch.out" 2>&1 &
 LAUNCH=$!
 trap 'kill -INT $LAUNCH 2>/dev/null || true' INT TERM
-echo "soak: $WORLD for $DURATION s, a sample every $INTERVAL s, output in $OUT"
+echo "soak: $WORLD for $DURATION s of sensor time at ${RATE}x real time, a sample every $INTERVAL s, output in $OUT"
 echo "t_s,process,pid,rss_mb,hwm_mb,threads,fds" > "$OUT/samples.csv"
 start=$SECONDS
 sample() {  # every live child of the launcher
-  local t=$((SECONDS - start)) pid comm
+  local t pid comm
+  t=$(awk -v s=$((SECONDS - start)) -v r="$RATE" 'BEGIN { printf "%d", s * r }')
   for pid in $(cat /proc/$LAUNCH/task/*/children 2>/dev/null); do
     [ -r "/proc/$pid/status" ] || continue
     comm=$(cat "/proc/$pid/comm" 2>/dev/null) || continue
