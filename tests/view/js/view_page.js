@@ -1,7 +1,8 @@
 // Opens adit view's page in Debian's chromium (headless, software GL), waits until the map has points, the
 // trajectory has poses and the STATUS panel has rows, prints window.aditState as JSON and saves a screenshot.
 //   node view_page.js URL SCREENSHOT.png [TIMEOUT_S [MEASURE_S]]   ($CHROMIUM: the browser, default /usr/bin/chromium;
-//   $ADIT_VIEW_MODE: top or follow for the screenshot; $ADIT_SAVE_MAP: see below)
+//   $ADIT_VIEW_MODE: top or follow for the screenshot; $ADIT_VIEW_SETTLE_S: seconds to let the run play on before
+//   the state and screenshot are taken, default 1.5; $ADIT_SAVE_MAP: see below)
 // MEASURE_S: for a log started --paused, press play once connected and measure the stream's bytes per second
 // over that many seconds (state.measured), before the checks (which then need no STATUS row).
 "use strict";
@@ -49,7 +50,8 @@ async function main() {
       await page.click("#save-map");
       await new Promise((r) => setTimeout(r, 500));
     }
-    await new Promise((r) => setTimeout(r, 1500));  // a few more frames drawn
+    const settle_s = Number(process.env.ADIT_VIEW_SETTLE_S || "1.5");  // a few more frames drawn, or more of the run
+    await new Promise((r) => setTimeout(r, settle_s * 1000));
     const state = await page.evaluate(() => JSON.parse(JSON.stringify(window.aditState)));
     state.page_errors = errors;
     state.speed_menu = await page.$eval("#speed", (el) => el.value);  // what the playback speed menu shows
