@@ -7,11 +7,11 @@
 
 namespace adit::runtime {
 
-void keepFreedMemoryForReuse() {
-  // Blocks up to 64 MB come from the heap (a 64-beam sweep with its copies is ~10 MB); up to 256 MB of free
-  // heap top stays mapped. Both fixed values also switch off glibc's threshold adaptation, so the behaviour does
-  // not depend on what was freed first.
-  mallopt(M_MMAP_THRESHOLD, 64 << 20);
+void keepFreedMemoryForReuse(std::size_t largest_heap_block) {
+  // Blocks below largest_heap_block come from the heap (a 64-beam sweep with its copies is ~10 MB); up to 256 MB
+  // of free heap top stays mapped. Both fixed values also switch off glibc's threshold adaptation, so the
+  // behaviour does not depend on what was freed first.
+  mallopt(M_MMAP_THRESHOLD, static_cast<int>(largest_heap_block));
   mallopt(M_TRIM_THRESHOLD, 256 << 20);
 }
 

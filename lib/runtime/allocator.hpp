@@ -2,6 +2,7 @@
 // (0.1-3 MB) every 100 ms.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 
 namespace adit::runtime {
@@ -10,7 +11,15 @@ namespace adit::runtime {
 // unmaps blocks above its (adaptive) mmap threshold and trims the heap top beyond 128 kB, so the next sweep's
 // buffers come back as fresh pages, each a page fault and a zero fill. Measured on `adit replay` of 30 s of
 // simulated VLP-16: 15 % less CPU, the same peak memory. Call before the first allocation that matters.
-void keepFreedMemoryForReuse();
+// Blocks from `largest_heap_block` bytes up are mapped per allocation and unmapped when freed.
+constexpr std::size_t kShortRunHeapBlock = std::size_t{64} << 20;  // adit replay, the CLI: up to 64 MB reused
+// A live stage runs for hours: its large temporaries grow with the run (the loop closer's graph copies for a
+// loop job, its checkpoints, the solver's matrices), and each new one, a little larger than the last, no longer
+// fits the hole the last one left in the heap. With 64 MB the loop closer's freed-but-kept memory grew by
+// ~90 MB per hour of driving while its memory in use stayed flat (soak, STATUS memory_* counters). Blocks of
+// 1 MB and up (above a VLP-16 sweep's buffers, so sweeps still reuse the heap) are mapped instead.
+constexpr std::size_t kLongRunHeapBlock = std::size_t{1} << 20;
+void keepFreedMemoryForReuse(std::size_t largest_heap_block = kShortRunHeapBlock);
 
 struct MemoryUse {
   std::int64_t resident_kb = 0;      // the process's resident set (/proc/self/statm), after the trim
@@ -19,9 +28,9 @@ struct MemoryUse {
 };
 
 // Measures the heap, then hands the free memory of every arena back to the kernel (glibc malloc_trim). A live
-// process calls it now and then (runNodeProcess: every 30 s, reported on STATUS as memory_*_kb): with the
-// settings above, freed blocks otherwise stay mapped for good, so a long-running stage keeps the high-water
-// mark of every temporary it ever made. Costs a few ms, and a page fault per page reused afterwards.
+// process calls it now and then (runNodeProcess: every 30 s, reported on STATUS as memory_*_kb), so what one
+// burst of work freed is not kept for the rest of the run. Costs a few ms, and a page fault per page reused
+// afterwards.
 MemoryUse returnFreeMemory();
 
 }  // namespace adit::runtime

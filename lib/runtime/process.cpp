@@ -142,7 +142,7 @@ void applyRemaps(Node& node, const std::vector<std::string>& remaps) {
 
 int runNodeProcess(int argc, char** argv, const std::string& name, const std::string& description,
                    const NodeFactory& factory) {
-  keepFreedMemoryForReuse();
+  keepFreedMemoryForReuse(kLongRunHeapBlock);
   CLI::App app{description, "adit-" + name};
   ProcessOptions options;
   addProcessOptions(app, options);
