@@ -2,6 +2,7 @@
 // what the graph's uncertainty between two keyframes is before any loop, used to gate loop candidates.
 #pragma once
 
+#include "core/shared_append_vector.hpp"
 #include "loop/se3.hpp"
 
 #include <vector>
@@ -23,8 +24,9 @@ class OdometryChain {
   Matrix6d covarianceBetween(int a, int b) const;
 
  private:
-  std::vector<Eigen::Isometry3d> poses_;
-  std::vector<Matrix6d> step_covariances_;  // [k]: step k-1 -> k ([0] unused)
+  // Shared by copies (a loop job's snapshot), which then cost a pointer per 512 keyframes.
+  SharedAppendVector<Eigen::Isometry3d> poses_;
+  SharedAppendVector<Matrix6d> step_covariances_;  // [k]: step k-1 -> k ([0] unused)
 };
 
 // Chi-square of a loop measurement Z = T_match_query against the graph's current estimate T_match_query_graph,

@@ -2,6 +2,7 @@
 // first node fixed, odometry edges weighted by their information, loop edges behind a robust loss.
 #pragma once
 
+#include "core/shared_append_vector.hpp"
 #include "core/types.hpp"
 
 #include <iosfwd>
@@ -51,11 +52,11 @@ class PoseGraph {
   const Eigen::Isometry3d& pose(int id) const { return poses_[static_cast<std::size_t>(id)]; }
   const std::vector<Eigen::Isometry3d>& poses() const { return poses_; }
   void setPose(int id, const Eigen::Isometry3d& pose) { poses_[static_cast<std::size_t>(id)] = pose; }
-  const std::vector<PoseGraphEdge>& edges() const { return edges_; }
+  const SharedAppendVector<PoseGraphEdge>& edges() const { return edges_; }
 
  private:
-  std::vector<Eigen::Isometry3d> poses_;
-  std::vector<PoseGraphEdge> edges_;
+  std::vector<Eigen::Isometry3d> poses_;  // copied by a copy of the graph (an optimisation moves them all)
+  SharedAppendVector<PoseGraphEdge> edges_;  // shared by copies (a loop job's snapshot): edges never change
 };
 
 // g2o text format (VERTEX_SE3:QUAT id x y z qx qy qz qw; EDGE_SE3:QUAT a b x y z qx qy qz qw + the 21 upper-
