@@ -56,8 +56,9 @@ class LoopCloserNode : public runtime::Node, public WritesProducts, public Write
   void useRunFolder(const runtime::RunFolder& folder) override {
     state_.setFolder(folder);
     std::string error;
-    if (state_.resume([this](const std::string& bytes) { return restore(bytes); }, error)) {
-      setCount("restarted", 1);
+    const bool resumed = state_.resume([this](const std::string& bytes) { return restore(bytes); }, error);
+    if (resumed || state_.restarted()) setCount("restarted", 1);
+    if (resumed) {
       setCount("recovered_keyframes", closer_.stats().keyframes);
       setCount("recovered_loops", static_cast<std::int64_t>(closer_.acceptedLoops().size()));
       spdlog::info("[loop_closer] resumed from {}: {} keyframes, {} loops, {} sweeps", state_.checkpointPath(),

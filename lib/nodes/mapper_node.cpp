@@ -63,9 +63,10 @@ class MapperNode : public runtime::Node, public WritesProducts {
     if (folder.live) mapper_.dropGlobalMap();
     state_.setFolder(folder);
     std::string error;
-    if (state_.resume([this](const std::string& bytes) { return restore(bytes); }, error)) {
+    const bool resumed = state_.resume([this](const std::string& bytes) { return restore(bytes); }, error);
+    if (resumed || state_.restarted()) setCount("restarted", 1);
+    if (resumed) {
       const ScanToMapMapper::State s = mapper_.state();
-      setCount("restarted", 1);
       setCount("recovered_map_points", static_cast<std::int64_t>(s.corners.size() + s.surfs.size()));
       spdlog::info("[mapper] resumed from {}: local map of {} points, last sweep at {}", state_.checkpointPath(),
                    s.corners.size() + s.surfs.size(), s.utime);

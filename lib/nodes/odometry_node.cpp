@@ -51,8 +51,9 @@ class OdometryNode : public runtime::Node {
   void useRunFolder(const runtime::RunFolder& folder) override {
     state_.setFolder(folder);
     std::string error;
-    if (state_.resume([this](const std::string& bytes) { return restore(bytes); }, error)) {
-      setCount("restarted", 1);
+    const bool resumed = state_.resume([this](const std::string& bytes) { return restore(bytes); }, error);
+    if (resumed || state_.restarted()) setCount("restarted", 1);
+    if (resumed) {
       spdlog::info("[odometry] resumed from {}: pose ({:.2f}, {:.2f}, {:.2f}) at {}", state_.checkpointPath(),
                    resume_->pose.translation().x(), resume_->pose.translation().y(),
                    resume_->pose.translation().z(), resume_->utime);
