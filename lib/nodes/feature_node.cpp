@@ -36,13 +36,9 @@ class FeatureNode : public runtime::Node {
     advertise("features", "FEATURES");
   }
 
- public:
-  // Nothing to recover (a few poses and IMU samples): a restart only says so on STATUS.
-  void useRunFolder(const runtime::RunFolder& folder) override {
-    if (folder.live && folder.restart_count > 0) setCount("restarted", 1);
-  }
-
  protected:
+  // No onRunFolder: nothing to recover (a few poses and IMU samples); a restart only says so on STATUS
+  // (Node::useRunFolder).
   void onTimeJump(const std::string& port) override {
     if (port == "points" || port == "odometry") {
       poses_.clear();

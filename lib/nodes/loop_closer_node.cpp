@@ -53,12 +53,12 @@ class LoopCloserNode : public runtime::Node, public WritesProducts, public Write
     writeMapBundle(bundleFrom(closer_, map_voxel_, config_keys_), dir);
   }
 
-  void useRunFolder(const runtime::RunFolder& folder) override {
+  void onRunFolder(const runtime::RunFolder& folder) override {
     state_.setFolder(folder);
     std::string error;
     const bool resumed = state_.resume([this](const std::string& bytes) { return restore(bytes); }, error);
-    if (resumed || state_.restarted()) setCount("restarted", 1);
     if (resumed) {
+      setCount("restarted", 1);  // also resumed from a given run folder without a restart
       setCount("recovered_keyframes", closer_.stats().keyframes);
       setCount("recovered_loops", static_cast<std::int64_t>(closer_.acceptedLoops().size()));
       spdlog::info("[loop_closer] resumed from {}: {} keyframes, {} loops, {} sweeps", state_.checkpointPath(),

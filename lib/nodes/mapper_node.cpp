@@ -58,14 +58,14 @@ class MapperNode : public runtime::Node, public WritesProducts {
   // The loop closer's map (corrected keyframes) replaces ours: the global map would only cost memory.
   void mapWrittenLater() override { mapper_.dropGlobalMap(); }
 
-  void useRunFolder(const runtime::RunFolder& folder) override {
+  void onRunFolder(const runtime::RunFolder& folder) override {
     // Live, the loop closer owns the map (save_map, the map saved on stop); this process writes none.
     if (folder.live) mapper_.dropGlobalMap();
     state_.setFolder(folder);
     std::string error;
     const bool resumed = state_.resume([this](const std::string& bytes) { return restore(bytes); }, error);
-    if (resumed || state_.restarted()) setCount("restarted", 1);
     if (resumed) {
+      setCount("restarted", 1);  // also resumed from a given run folder without a restart
       const ScanToMapMapper::State s = mapper_.state();
       setCount("recovered_map_points", static_cast<std::int64_t>(s.corners.size() + s.surfs.size()));
       spdlog::info("[mapper] resumed from {}: local map of {} points, last sweep at {}", state_.checkpointPath(),

@@ -48,12 +48,12 @@ class OdometryNode : public runtime::Node {
     advertise("odometry", "ODOM_SCAN");
   }
 
-  void useRunFolder(const runtime::RunFolder& folder) override {
+  void onRunFolder(const runtime::RunFolder& folder) override {
     state_.setFolder(folder);
     std::string error;
     const bool resumed = state_.resume([this](const std::string& bytes) { return restore(bytes); }, error);
-    if (resumed || state_.restarted()) setCount("restarted", 1);
     if (resumed) {
+      setCount("restarted", 1);  // also resumed from a given run folder without a restart
       spdlog::info("[odometry] resumed from {}: pose ({:.2f}, {:.2f}, {:.2f}) at {}", state_.checkpointPath(),
                    resume_->pose.translation().x(), resume_->pose.translation().y(),
                    resume_->pose.translation().z(), resume_->utime);

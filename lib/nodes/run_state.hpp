@@ -33,9 +33,6 @@ class RunState {
   const runtime::RunFolder& folder() const { return folder_; }
   bool live() const { return folder_.live; }
   std::string checkpointPath() const { return folder_.file(kind_ + ".ckpt"); }
-  // `adit launch` restarted this process (STATUS counter `restarted`, state "restarted"), whether or not a
-  // checkpoint could be resumed: an operator must see the crash even when everything before it was lost.
-  bool restarted() const { return folder_.live && folder_.restart_count > 0; }
 
   // Resumes when the folder allows it and a checkpoint of this run is there: `restore` gets the payload and
   // returns "" or why it is unusable. Returns true if restored. `error` gets a refusal (already logged).

@@ -118,8 +118,13 @@ class Node {
   virtual std::string state() const { return "running"; }
 
   // Where this run's files go (products, checkpoints); called once before the first input. Live processes
-  // pass RunFolder::live = true: a stage may then resume from its checkpoint and save on stop.
-  virtual void useRunFolder(const RunFolder& /*folder*/) {}
+  // pass RunFolder::live = true: a stage may then resume from its checkpoint and save on stop (onRunFolder).
+  // A process that `adit launch` restarted says so on STATUS (counter `restarted`) whatever it recovers: an
+  // operator must see the crash even when everything before it was lost.
+  void useRunFolder(const RunFolder& folder) {
+    if (folder.live && folder.restart_count > 0) setCount("restarted", 1);
+    onRunFolder(folder);
+  }
 
   // Forward gaps in sensor time above this are counted as "time_jump" and reported to onTimeJump().
   void setMaxTimeGap(double seconds) { max_time_gap_us_ = static_cast<std::int64_t>(seconds * 1e6); }
@@ -143,6 +148,8 @@ class Node {
   void count(const std::string& counter, std::int64_t n = 1) { health_.counters[counter] += n; }
   // For counters a stage keeps itself: report its current value.
   void setCount(const std::string& counter, std::int64_t value) { health_.counters[counter] = value; }
+  // The run folder, for nodes that resume from or write into it (useRunFolder).
+  virtual void onRunFolder(const RunFolder& /*folder*/) {}
   // Count an input that could not be used (errors) or was skipped (drops). One log line per burst: repeats of
   // the same counter are logged as one summary line once an input is accepted again.
   void reportError(const std::string& counter, const std::string& message);
