@@ -6,6 +6,7 @@
 
 #include <Eigen/Cholesky>
 
+#include <algorithm>
 #include <memory>
 
 namespace adit {
@@ -89,7 +90,9 @@ PoseGraphReport PoseGraph::optimize(const PoseGraphConfig& config) {
   ceres::EigenQuaternionManifold quaternion_manifold;
   ceres::CauchyLoss loop_loss(config.loop_loss_scale);  // owned here, not by the problem
 
+  const auto fixed = [&](int id) { return id < std::max(1, config.fixed_nodes); };
   for (const PoseGraphEdge& e : edges_) {
+    if (fixed(e.from) && fixed(e.to)) continue;  // nothing it could move
     const Matrix6d sqrt_info = e.information.llt().matrixU();
     auto* cost = new ceres::AutoDiffCostFunction<RelativePoseError, 6, 3, 4, 3, 4>(
         new RelativePoseError(e.T_from_to, sqrt_info));
@@ -100,9 +103,14 @@ PoseGraphReport PoseGraph::optimize(const PoseGraphConfig& config) {
   }
   for (NodeState& s : state)
     if (problem.HasParameterBlock(s.q.coeffs().data())) problem.SetManifold(s.q.coeffs().data(), &quaternion_manifold);
-  if (problem.HasParameterBlock(state[0].p.data())) {
-    problem.SetParameterBlockConstant(state[0].p.data());
-    problem.SetParameterBlockConstant(state[0].q.coeffs().data());
+  for (std::size_t i = 0; i < state.size() && fixed(static_cast<int>(i)); ++i) {
+    if (!problem.HasParameterBlock(state[i].p.data())) continue;
+    problem.SetParameterBlockConstant(state[i].p.data());
+    problem.SetParameterBlockConstant(state[i].q.coeffs().data());
+  }
+  if (problem.NumResidualBlocks() == 0) {
+    report.solved = true;
+    return report;
   }
 
   ceres::Solver::Options options;

@@ -19,6 +19,9 @@ struct PoseGraphConfig {
   // few-cm noise) away, so a small scale would silence exactly the loops we want; 10 keeps those near their
   // quadratic region while a gross false loop (20 m off = ~400 sigma) pulls with ~1/40 of its weight.
   double loop_loss_scale = 10.0;
+  // Nodes 0 .. fixed_nodes-1 are held where they are (at least node 0: the graph's frame). A map bundle being
+  // extended (map/bundle_extend.hpp) holds every node of the saved map and moves only the new session's.
+  int fixed_nodes = 1;
 };
 
 struct PoseGraphEdge {
