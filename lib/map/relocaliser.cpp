@@ -87,7 +87,7 @@ Relocaliser::Result Relocaliser::process(const PoseEstimate& session, const std:
   if (state_ == RelocState::kRelocalising) {
     relocalise(session, result);
   } else {
-    track(session);
+    result.anchored_now = track(session);
     if (state_ == RelocState::kRelocalising) result.lost_now = true;
   }
   result.state = state_;
@@ -132,6 +132,7 @@ void Relocaliser::relocalise(const PoseEstimate& session, Result& result) {
   track_failures_ = 0;
   ++stats_.fixes;
   result.fixed_now = true;
+  result.anchored_now = true;
 }
 
 // The newest sweeps in the current sweep's frame, downsampled as a keyframe's cloud.
@@ -385,8 +386,8 @@ bool Relocaliser::consistent(const Fix& a, const Fix& b) const {
 }
 
 // Localised: verify the sweep against the bundle keyframes nearest its predicted map pose and refine the offset.
-void Relocaliser::track(const PoseEstimate& session) {
-  if (travelled_ - last_query_travelled_ < config_.track_distance) return;
+bool Relocaliser::track(const PoseEstimate& session) {
+  if (travelled_ - last_query_travelled_ < config_.track_distance) return false;
   last_query_travelled_ = travelled_;
   const Eigen::Isometry3d predicted = T_map_session_ * session.pose;
   const int nearest = nearestKeyframe(predicted.translation());
@@ -401,7 +402,7 @@ void Relocaliser::track(const PoseEstimate& session) {
     if (v.verdict == LoopVerdict::kDegenerate && small) {
       ++stats_.track_degenerate;
       track_failures_ = 0;
-      return;
+      return false;
     }
     ok = v.verdict == LoopVerdict::kAccepted && small;
     if (ok) T_map_session_ = orthonormal(refined * session.pose.inverse());
@@ -413,6 +414,7 @@ void Relocaliser::track(const PoseEstimate& session) {
     ++stats_.track_failed;
     if (++track_failures_ >= config_.max_track_failures) loseFix();
   }
+  return ok;
 }
 
 }  // namespace adit

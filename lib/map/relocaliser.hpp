@@ -108,6 +108,9 @@ class Relocaliser {
     RelocState state = RelocState::kRelocalising;
     bool fixed_now = false;  // this sweep gave the fix
     bool lost_now = false;
+    // This sweep's pose in the map was measured, not carried by odometry: the fix, or a verified tracking fit
+    // (what ties a session extending the map to it, map/bundle_extend.hpp).
+    bool anchored_now = false;
     std::optional<Eigen::Isometry3d> T_map_lidar;  // only when localised
   };
   // session: the run's own pose (mapper output) of the sweep; cloud: its deskewed points, lidar frame.
@@ -131,7 +134,7 @@ class Relocaliser {
     double travelled = 0.0;         // session distance driven at the query
   };
   void relocalise(const PoseEstimate& session, Result& result);
-  void track(const PoseEstimate& session);
+  bool track(const PoseEstimate& session);  // true when a tracking fit refined the pose
   std::optional<Fix> query(const PoseEstimate& session, const std::vector<Eigen::Vector3f>& cloud);
   std::optional<Fix> bestFix(const PoseEstimate& session, const std::vector<Eigen::Vector3f>& cloud, RelocQueryRecord& record);
   // ICP with the search along a weak direction; counts into `stats` (the background judgement has its own).

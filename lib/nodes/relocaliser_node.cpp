@@ -75,6 +75,7 @@ class RelocaliserNode : public runtime::Node, public WritesProducts {
       in_map_.push_back({session.utime, *r.T_map_lidar});
       adit::odometry_t out = msg::toMessage(PoseEstimate{session.utime, *r.T_map_lidar}, nullptr);
       out.header = msg::makeHeader(session.utime, "map");
+      if (r.anchored_now) out.flags |= adit::odometry_t::FLAG_MAP_MEASURED;  // what an extending run ties to the map
       publish("pose", out);
     }
     const RelocStats& s = relocaliser_->stats();
