@@ -4,6 +4,7 @@
 #include "core/config.hpp"
 #include "io/atomic_file.hpp"
 #include "io/pcd.hpp"
+#include "io/pcd_format.hpp"
 #include "loop/keyframe_codec.hpp"
 #include "loop/loop_closer.hpp"
 #include "runtime/checkpoint.hpp"
@@ -11,6 +12,7 @@
 #include <fmt/format.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <ctime>
 #include <filesystem>
 #include <fstream>
@@ -149,15 +151,35 @@ std::string bundleSensorMismatch(const BundleSummary& bundle, const std::map<std
   return "";
 }
 
-double roadwayLength(const std::vector<Eigen::Vector3d>& positions, double revisit_radius, int recent) {
+double roadwayLength(const std::vector<Eigen::Vector3d>& positions, double revisit_radius, int recent,
+                     const std::vector<Eigen::Vector3d>& mapped) {
+  const auto near = [&](const Eigen::Vector3d& p, const Eigen::Vector3d& q) { return (p - q).norm() < revisit_radius; };
   double length = 0.0;
   for (std::size_t k = 1; k < positions.size(); ++k) {
-    bool revisit = false;
-    for (std::size_t j = 0; j + static_cast<std::size_t>(recent) < k && !revisit; ++j)
-      revisit = (positions[j] - positions[k]).norm() < revisit_radius;
+    bool revisit = std::any_of(mapped.begin(), mapped.end(), [&](const Eigen::Vector3d& m) { return near(m, positions[k]); });
+    for (std::size_t j = 0; j + static_cast<std::size_t>(recent) < k && !revisit; ++j) revisit = near(positions[j], positions[k]);
     if (!revisit) length += (positions[k] - positions[k - 1]).norm();
   }
   return length;
+}
+
+BundleSummary bundleSummaryOf(const std::vector<BundleKeyframe>& keyframes, double map_voxel,
+                              const std::map<std::string, std::string>& config, double roadway_length_m) {
+  BundleSummary s;
+  s.version = kMapBundleVersion;
+  std::int64_t newest = 0;
+  for (const BundleKeyframe& k : keyframes) newest = std::max(newest, k.utime);
+  s.created = isoDate(newest);
+  s.keyframes = static_cast<int>(keyframes.size());
+  if (!keyframes.empty()) s.extent_min = s.extent_max = keyframes.front().pose.translation();
+  for (const BundleKeyframe& k : keyframes) {
+    s.extent_min = s.extent_min.cwiseMin(k.pose.translation());
+    s.extent_max = s.extent_max.cwiseMax(k.pose.translation());
+  }
+  s.roadway_length_m = roadway_length_m;
+  s.map_voxel = map_voxel;
+  s.sensor = bundleSensorKeys(config);
+  return s;
 }
 
 MapBundle bundleFrom(const LoopCloser& closer, double map_voxel, const std::map<std::string, std::string>& config) {
@@ -172,18 +194,7 @@ MapBundle bundleFrom(const LoopCloser& closer, double map_voxel, const std::map<
   b.graph = closer.graph();
   b.map = closer.correctedMap(map_voxel);
   b.config = config;
-  BundleSummary& s = b.summary;
-  s.version = kMapBundleVersion;
-  s.created = b.keyframes.empty() ? isoDate(0) : isoDate(b.keyframes.back().utime);
-  s.keyframes = static_cast<int>(b.keyframes.size());
-  if (!positions.empty()) s.extent_min = s.extent_max = positions.front();
-  for (const Eigen::Vector3d& p : positions) {
-    s.extent_min = s.extent_min.cwiseMin(p);
-    s.extent_max = s.extent_max.cwiseMax(p);
-  }
-  s.roadway_length_m = roadwayLength(positions);
-  s.map_voxel = map_voxel;
-  s.sensor = bundleSensorKeys(config);
+  b.summary = bundleSummaryOf(b.keyframes, map_voxel, config, roadwayLength(positions));
   return b;
 }
 
@@ -269,6 +280,28 @@ MapBundle loadMapBundle(const std::string& dir) {
     throw BundleError(dir + "/config.yaml is not valid YAML: " + std::string(e.what()));
   }
   return b;
+}
+
+std::vector<Eigen::Vector3f> loadBundleMap(const std::string& dir) {
+  const std::string path = (fs::path(dir) / "map.pcd").string();
+  try {
+    const io::PcdCloud cloud = io::readPcdFile(path);
+    const io::PcdField* x = cloud.field("x");
+    const io::PcdField* y = cloud.field("y");
+    const io::PcdField* z = cloud.field("z");
+    if (!x || !y || !z) throw BundleError(path + " has no x, y and z fields");
+    std::vector<Eigen::Vector3f> points;
+    points.reserve(cloud.points);
+    for (std::size_t i = 0; i < cloud.points; ++i) {
+      const std::uint8_t* point = cloud.data.data() + i * cloud.point_step;
+      const Eigen::Vector3f p(static_cast<float>(x->read(point)), static_cast<float>(y->read(point)),
+                              static_cast<float>(z->read(point)));
+      if (p.allFinite()) points.push_back(p);
+    }
+    return points;
+  } catch (const io::ReadError& e) {
+    throw BundleError(e.what());
+  }
 }
 
 }  // namespace adit

@@ -70,8 +70,13 @@ std::string bundleSensorMismatch(const BundleSummary& bundle, const std::map<std
 // The bundle of a loop closer's state: keyframes at their corrected poses, graph, map (voxel map_voxel).
 MapBundle bundleFrom(const LoopCloser& closer, double map_voxel, const std::map<std::string, std::string>& config);
 // Distinct roadway length (m) of a keyframe path: steps ending within `revisit_radius` of a keyframe more than
-// `recent` keyframes older are a revisit and not counted.
-double roadwayLength(const std::vector<Eigen::Vector3d>& positions, double revisit_radius = 3.0, int recent = 30);
+// `recent` keyframes older, or of any `mapped` position (roadway an earlier session already holds), are a
+// revisit and not counted.
+double roadwayLength(const std::vector<Eigen::Vector3d>& positions, double revisit_radius = 3.0, int recent = 30,
+                     const std::vector<Eigen::Vector3d>& mapped = {});
+// The manifest's summary of these keyframes (extent, newest sensor date, sensor keys of `config`).
+BundleSummary bundleSummaryOf(const std::vector<BundleKeyframe>& keyframes, double map_voxel,
+                              const std::map<std::string, std::string>& config, double roadway_length_m);
 
 // Writes the bundle folder atomically (see above); throws std::runtime_error naming what failed.
 void writeMapBundle(const MapBundle& bundle, const std::string& dir);
@@ -79,5 +84,7 @@ void writeMapBundle(const MapBundle& bundle, const std::string& dir);
 BundleSummary readBundleSummary(const std::string& dir);
 // Everything but the map points (not needed to relocalise; they are checksummed): throws BundleError.
 MapBundle loadMapBundle(const std::string& dir);
+// The map points (map.pcd) of a bundle whose summary has been read (checksums checked): throws BundleError.
+std::vector<Eigen::Vector3f> loadBundleMap(const std::string& dir);
 
 }  // namespace adit

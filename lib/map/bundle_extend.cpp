@@ -1,0 +1,242 @@
+#include "map/bundle_extend.hpp"
+
+#include "loop/voxel_filter.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdlib>
+#include <limits>
+#include <map>
+#include <optional>
+#include <unordered_set>
+
+namespace adit {
+
+const ConfigTable<BundleExtendConfig>& bundleExtendConfigTable() {
+  using E = BundleExtendConfig;
+  static const ConfigTable<E> table = [] {
+    ConfigTable<E> t("reloc.extend");
+    t.add("overlap_radius", &E::overlap_radius, above(0), "m", "extend: a new keyframe this close to a saved one is roadway the map already holds (dropped)")
+     .add("max_anchor_gap_s", &E::max_anchor_gap_s, above(0), "s", "extend: a measured pose in the map ties the keyframe nearest it in time when within this")
+     .add("anchor_sigma_m", &E::anchor_sigma_m, above(0), "m", "extend: standard deviation of a measured pose in the map (translation)")
+     .add("anchor_sigma_deg", &E::anchor_sigma_deg, above(0), "deg", "extend: standard deviation of a measured pose in the map (rotation)")
+     .add("map_clearance_voxels", &E::map_clearance_voxels, between(0, 10), "voxels", "extend: a new map point is added only where no saved point lies within this many voxels");
+    return t;
+  }();
+  return table;
+}
+
+namespace {
+
+// The element of `trajectory` (sorted by time) nearest `utime`, or nullptr when none is within `tolerance_us`.
+const StampedPose* nearestInTime(const Trajectory& trajectory, std::int64_t utime, std::int64_t tolerance_us) {
+  const auto after = std::lower_bound(trajectory.begin(), trajectory.end(), utime,
+                                      [](const StampedPose& p, std::int64_t t) { return p.utime < t; });
+  const StampedPose* best = nullptr;
+  if (after != trajectory.end()) best = &*after;
+  if (after != trajectory.begin() && (!best || utime - std::prev(after)->utime < best->utime - utime)) best = &*std::prev(after);
+  return best && std::llabs(best->utime - utime) <= tolerance_us ? best : nullptr;
+}
+
+// Index of the keyframe nearest `utime` (keyframes are in time order).
+int nearestKeyframeInTime(const std::vector<BundleKeyframe>& keyframes, std::int64_t utime) {
+  const auto after = std::lower_bound(keyframes.begin(), keyframes.end(), utime,
+                                      [](const BundleKeyframe& k, std::int64_t t) { return k.utime < t; });
+  int best = after == keyframes.end() ? -1 : static_cast<int>(after - keyframes.begin());
+  if (after != keyframes.begin() && (best < 0 || utime - std::prev(after)->utime < after->utime - utime))
+    best = static_cast<int>(after - keyframes.begin()) - 1;
+  return best;
+}
+
+// Index of the saved keyframe nearest `position` and its distance.
+std::pair<int, double> nearestKeyframe(const std::vector<BundleKeyframe>& keyframes, const Eigen::Vector3d& position) {
+  std::pair<int, double> best{-1, std::numeric_limits<double>::infinity()};
+  for (std::size_t k = 0; k < keyframes.size(); ++k) {
+    const double d = (keyframes[k].pose.translation() - position).norm();
+    if (d < best.second) best = {static_cast<int>(k), d};
+  }
+  return best;
+}
+
+Matrix6d anchorInformation(const BundleExtendConfig& c) {
+  const double sigma_r = c.anchor_sigma_deg * M_PI / 180.0;
+  Matrix6d information = Matrix6d::Zero();
+  information.diagonal() << Eigen::Vector3d::Constant(1.0 / (c.anchor_sigma_m * c.anchor_sigma_m)),
+      Eigen::Vector3d::Constant(1.0 / (sigma_r * sigma_r));
+  return information;
+}
+
+// Voxels the saved map occupies: a new point near one of them would be a second copy of a mapped surface.
+class Occupancy {
+ public:
+  explicit Occupancy(double cell) : cell_(cell) {}
+  void add(const Eigen::Vector3f& p) { cells_.insert(key(p)); }
+  bool near(const Eigen::Vector3f& p, int clearance) const {
+    const Key k = key(p);
+    for (int dx = -clearance; dx <= clearance; ++dx)
+      for (int dy = -clearance; dy <= clearance; ++dy)
+        for (int dz = -clearance; dz <= clearance; ++dz)
+          if (cells_.count({k[0] + dx, k[1] + dy, k[2] + dz})) return true;
+    return false;
+  }
+
+ private:
+  using Key = std::array<long long, 3>;
+  struct Hash {
+    std::size_t operator()(const Key& k) const {
+      return static_cast<std::size_t>(k[0] * 73856093LL ^ k[1] * 19349663LL ^ k[2] * 83492791LL);
+    }
+  };
+  Key key(const Eigen::Vector3f& p) const {
+    return {static_cast<long long>(std::floor(p.x() / cell_)), static_cast<long long>(std::floor(p.y() / cell_)),
+            static_cast<long long>(std::floor(p.z() / cell_))};
+  }
+  double cell_;
+  std::unordered_set<Key, Hash> cells_;  // looked up only: its order never reaches the result
+};
+
+// Session keyframe -> its pose in the map frame, from the anchor nearest it in time (one per keyframe).
+std::map<int, Eigen::Isometry3d> anchoredKeyframes(const MapBundle& session, const Trajectory& session_poses,
+                                                   const Trajectory& anchors, const BundleExtendConfig& config) {
+  std::map<int, std::pair<std::int64_t, Eigen::Isometry3d>> best;  // keyframe -> (time gap, pose in map)
+  const auto max_gap = static_cast<std::int64_t>(config.max_anchor_gap_s * 1e6);
+  for (const StampedPose& anchor : anchors) {
+    const StampedPose* sweep = nearestInTime(session_poses, anchor.utime, 1000);  // the same sweep (TUM: 1 us)
+    const int k = nearestKeyframeInTime(session.keyframes, anchor.utime);
+    if (!sweep || k < 0 || !anchor.pose.matrix().allFinite()) continue;
+    const std::int64_t gap = std::llabs(session.keyframes[static_cast<std::size_t>(k)].utime - anchor.utime);
+    if (gap > max_gap || (best.count(k) && best[k].first <= gap)) continue;
+    // The keyframe is a few centimetres of session motion from the anchored sweep: carry the anchor over it.
+    best[k] = {gap, anchor.pose * sweep->pose.inverse() * session.keyframes[static_cast<std::size_t>(k)].pose};
+  }
+  std::map<int, Eigen::Isometry3d> out;
+  for (const auto& [k, v] : best) out[k] = v.second;
+  return out;
+}
+
+}  // namespace
+
+MapBundle extendBundle(const MapBundle& prior, const MapBundle& session, const Trajectory& session_poses,
+                       const Trajectory& anchors, const BundleExtendConfig& config, BundleExtendReport* report_out) {
+  BundleExtendReport report;
+  const int N = static_cast<int>(prior.keyframes.size());
+  const int M = static_cast<int>(session.keyframes.size());
+  if (N == 0 || prior.graph.size() != N) throw BundleError("the saved map has no keyframes or a pose graph of another size");
+  if (M == 0 || session.graph.size() != M) throw BundleError("the new session has no keyframes to add");
+  if (const std::string mismatch = bundleSensorMismatch(prior.summary, session.config); !mismatch.empty())
+    throw BundleError("the new session's sensor configuration differs from the saved map's: " + mismatch);
+  const std::map<int, Eigen::Isometry3d> anchored = anchoredKeyframes(session, session_poses, anchors, config);
+  report.anchors = static_cast<int>(anchors.size());
+  report.anchors_used = static_cast<int>(anchored.size());
+  report.session_keyframes = M;
+  if (anchored.empty())
+    throw BundleError(fmt::format("the new session never relocalised in the saved map ({} measured poses, none within "
+                                  "{} s of a keyframe): nothing ties it to the map",
+                                  anchors.size(), config.max_anchor_gap_s));
+
+  // The joint graph: the saved map's nodes (fixed), then the session's, started from the offset to the map of
+  // the anchor nearest in time.
+  PoseGraph graph = prior.graph;
+  std::vector<std::pair<std::int64_t, Eigen::Isometry3d>> offsets;  // T_map_session at anchored keyframes
+  for (const auto& [k, T_map_kf] : anchored)
+    offsets.emplace_back(session.keyframes[static_cast<std::size_t>(k)].utime,
+                         T_map_kf * session.keyframes[static_cast<std::size_t>(k)].pose.inverse());
+  for (const BundleKeyframe& k : session.keyframes) {
+    const auto nearest = std::min_element(offsets.begin(), offsets.end(), [&](const auto& a, const auto& b) {
+      return std::llabs(a.first - k.utime) < std::llabs(b.first - k.utime);
+    });
+    graph.addNode(nearest->second * k.pose);
+  }
+  for (PoseGraphEdge e : session.graph.edges()) {
+    e.from += N;
+    e.to += N;
+    graph.addEdge(e);
+  }
+  const Matrix6d information = anchorInformation(config);
+  std::vector<PoseGraphEdge> anchor_edges;
+  for (const auto& [k, T_map_kf] : anchored) {
+    const int j = nearestKeyframe(prior.keyframes, T_map_kf.translation()).first;
+    anchor_edges.push_back({j, N + k, prior.keyframes[static_cast<std::size_t>(j)].pose.inverse() * T_map_kf, information, true});
+    graph.addEdge(anchor_edges.back());
+  }
+  PoseGraphConfig solve;
+  solve.fixed_nodes = N;
+  solve.max_iterations = 100;
+  report.solved = graph.optimize(solve).solved;
+  if (!report.solved) throw BundleError("the pose graph joining the new session to the saved map did not solve");
+
+  // Keyframes where the session drove through mapped roadway are dropped; the rest join the bundle.
+  MapBundle out;
+  out.keyframes = prior.keyframes;
+  for (int i = 0; i < N; ++i) out.graph.addNode(prior.graph.pose(i));
+  for (const PoseGraphEdge& e : prior.graph.edges()) out.graph.addEdge(e);
+  std::vector<int> id(static_cast<std::size_t>(M), -1);
+  std::vector<Eigen::Vector3d> session_positions, prior_positions;
+  for (const BundleKeyframe& k : prior.keyframes) prior_positions.push_back(k.pose.translation());
+  for (int i = 0; i < M; ++i) {
+    const Eigen::Isometry3d& pose = graph.pose(N + i);
+    session_positions.push_back(pose.translation());
+    if (nearestKeyframe(prior.keyframes, pose.translation()).second < config.overlap_radius) {
+      ++report.overlap_keyframes;
+      continue;
+    }
+    const BundleKeyframe& k = session.keyframes[static_cast<std::size_t>(i)];
+    id[static_cast<std::size_t>(i)] = out.graph.addNode(pose);
+    out.keyframes.push_back({k.utime, pose, k.cloud, k.context});
+  }
+  report.kept_keyframes = M - report.overlap_keyframes;
+  const auto kept = [&](int i) { return i >= 0 && i < M && id[static_cast<std::size_t>(i)] >= 0; };
+  for (PoseGraphEdge e : session.graph.edges()) {
+    if (!kept(e.from) || !kept(e.to)) continue;
+    e.from = id[static_cast<std::size_t>(e.from)];
+    e.to = id[static_cast<std::size_t>(e.to)];
+    out.graph.addEdge(e);
+  }
+  for (PoseGraphEdge e : anchor_edges) {
+    if (!kept(e.to - N)) continue;
+    e.to = id[static_cast<std::size_t>(e.to - N)];
+    out.graph.addEdge(e);
+  }
+  // A kept stretch whose neighbour was dropped meets the saved map there: join it to the nearest saved keyframe
+  // at the solved relative pose, so the saved graph stays one connected graph.
+  for (int i = 0; i < M; ++i) {
+    if (!kept(i) || ((i == 0 || kept(i - 1)) && (i == M - 1 || kept(i + 1)))) continue;
+    const Eigen::Isometry3d& pose = graph.pose(N + i);
+    const int j = nearestKeyframe(prior.keyframes, pose.translation()).first;
+    out.graph.addOdometryEdge(j, id[static_cast<std::size_t>(i)], prior.keyframes[static_cast<std::size_t>(j)].pose.inverse() * pose,
+                              information);
+    ++report.junction_edges;
+  }
+
+  // The map: every saved point, and the kept keyframes' points where the saved map has none nearby.
+  const double voxel = prior.summary.map_voxel;
+  Occupancy occupied(voxel > 0 ? voxel : 0.1);
+  std::optional<VoxelAccumulator> grid;  // map_voxel 0: the points as they are
+  if (voxel > 0) grid.emplace(voxel);
+  const auto add = [&](const Eigen::Vector3f& p) { grid ? grid->add(p) : out.map.push_back(p); };
+  for (const Eigen::Vector3f& p : prior.map) {
+    occupied.add(p);
+    add(p);
+  }
+  for (int i = 0; i < M; ++i) {
+    if (!kept(i)) continue;
+    const Eigen::Isometry3f T = graph.pose(N + i).cast<float>();
+    for (const Eigen::Vector3f& p : session.keyframes[static_cast<std::size_t>(i)].cloud.decode()) {
+      const Eigen::Vector3f w = T * p;
+      if (!w.allFinite() || occupied.near(w, config.map_clearance_voxels)) continue;
+      add(w);
+      ++report.map_points_added;
+    }
+  }
+  if (grid) out.map = grid->centroids();
+  out.config = session.config;
+  report.added_roadway_m = roadwayLength(session_positions, 3.0, 30, prior_positions);
+  out.summary = bundleSummaryOf(out.keyframes, voxel, out.config, prior.summary.roadway_length_m + report.added_roadway_m);
+  if (report_out) *report_out = report;
+  return out;
+}
+
+}  // namespace adit
