@@ -4,6 +4,7 @@
 #include "core/geometry.hpp"
 #include "loop/loop_closer.hpp"
 #include "loop/pose_graph.hpp"
+#include "map/bundle_extend.hpp"
 #include "map/map_bundle.hpp"
 #include "map/map_products.hpp"
 #include "map/map_updates.hpp"
@@ -36,8 +37,12 @@ class LoopCloserNode : public runtime::Node, public WritesProducts, public Write
       : Node("loop_closer"), closer_(loopCloserConfigFrom(config)),
         map_voxel_(loopCloserNodeConfigTable().read(config).map_voxel),
         checkpoint_keyframes_(loopCloserNodeConfigTable().read(config).checkpoint_keyframes),
-        updates_(mapUpdateConfigFrom(config)), config_keys_(pipelineConfigKeys(config)), state_("loop_closer") {
+        updates_(mapUpdateConfigFrom(config)), config_keys_(pipelineConfigKeys(config)),
+        reloc_(relocNodeConfigTable().read(config)), state_("loop_closer") {
     subscribe<adit::odometry_t>("mapped", "ODOM_MAPPED", [this](const adit::odometry_t& m) { onMapped(m); });
+    // Extending a saved map: the relocaliser's measured poses in it are what join this run's map to it.
+    if (reloc_.extending())
+      subscribe<adit::odometry_t>("pose_in_map", "POSE_IN_MAP", [this](const adit::odometry_t& m) { onPoseInMap(m); });
     subscribe<adit::command_t>("command", "MAPPER_COMMAND", [this](const adit::command_t& m) { onCommand(m); },
                                runtime::InputKind::Requests);
     advertise("loop", "LOOP_CLOSURE");
@@ -49,8 +54,26 @@ class LoopCloserNode : public runtime::Node, public WritesProducts, public Write
     return writeMapProducts(closer_, uncorrected_, map_voxel_, out_dir);
   }
   bool writesMap() const override { return true; }
-  void writeBundle(const std::string& dir) override {
-    writeMapBundle(bundleFrom(closer_, map_voxel_, config_keys_), dir);
+  // The run's own map, or (extending a saved map) the saved map joined with this run's new roadway.
+  MapBundle mapBundle() override {
+    MapBundle run = bundleFrom(closer_, map_voxel_, config_keys_);
+    if (!reloc_.extending()) return run;
+    MapBundle prior;
+    try {
+      prior = loadMapBundle(reloc_.prior_map);
+      prior.map = loadBundleMap(reloc_.prior_map);
+      BundleExtendReport r;
+      MapBundle both = extendBundle(prior, run, closer_.correctedTrajectory(uncorrected_), anchors_, reloc_.extend, &r);
+      setCount("extend_anchors_used", r.anchors_used);
+      setCount("extend_keyframes_added", r.kept_keyframes);
+      setCount("extend_keyframes_overlap", r.overlap_keyframes);
+      spdlog::info("[loop_closer] extended {}: {} of {} keyframes added ({} on mapped roadway), {} anchors used, "
+                   "{} map points and {:.0f} m of roadway added", reloc_.prior_map, r.kept_keyframes,
+                   r.session_keyframes, r.overlap_keyframes, r.anchors_used, r.map_points_added, r.added_roadway_m);
+      return both;
+    } catch (const BundleError& e) {
+      throw std::runtime_error("cannot extend " + reloc_.prior_map + ": " + e.what());
+    }
   }
 
   void onRunFolder(const runtime::RunFolder& folder) override {
@@ -82,6 +105,12 @@ class LoopCloserNode : public runtime::Node, public WritesProducts, public Write
   }
 
  private:
+  void onPoseInMap(const adit::odometry_t& m) {
+    if (!(m.flags & adit::odometry_t::FLAG_MAP_MEASURED)) return;  // carried by odometry: ties nothing
+    const PoseEstimate measured = msg::fromMessage(m);
+    if (measured.pose.matrix().allFinite()) anchors_.push_back({measured.utime, measured.pose});
+  }
+
   void onMapped(const adit::odometry_t& m) {
     PoseEstimate mapped = msg::fromMessage(m);
     // The graph is built on uncorrected poses: undo the correction the mapper had already applied.
@@ -145,7 +174,7 @@ class LoopCloserNode : public runtime::Node, public WritesProducts, public Write
   void saveBundle(const std::string& name) {
     try {
       const std::string dir = state_.folder().file(name);
-      writeBundle(dir);
+      writeMapBundle(mapBundle(), dir);
       count("bundles_saved");
       spdlog::info("[loop_closer] saved map bundle {} ({} keyframes)", dir, closer_.stats().keyframes);
     } catch (const std::exception& e) {
@@ -280,6 +309,8 @@ class LoopCloserNode : public runtime::Node, public WritesProducts, public Write
   int checkpoint_keyframes_;
   MapUpdateTracker updates_;
   std::map<std::string, std::string> config_keys_;  // every pipeline key, for the bundle's config.yaml
+  RelocNodeConfig reloc_;
+  Trajectory anchors_;  // extending: the relocaliser's measured poses in the saved map (one a metre, not checkpointed)
   runtime::RecordLog keyframes_log_;  // the writer thread's, once the run started
   std::shared_ptr<std::atomic<std::size_t>> keyframes_written_ = std::make_shared<std::atomic<std::size_t>>(0);
   RunState state_;  // after what its jobs use: its writer thread stops first

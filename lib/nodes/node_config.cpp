@@ -99,7 +99,9 @@ const ConfigTable<RelocNodeConfig>& relocNodeConfigTable() {
   static const ConfigTable<N> table = [] {
     ConfigTable<N> t("reloc");
     t.add("prior_map", &N::prior_map, anyValue(), "", "map bundle folder to relocalise in (\"\" = none: map from scratch)")
-     .add("mode", &N::mode, oneOf({"localise"}), "", "localise: the bundle stays fixed, the pose in it is published");
+     .add("mode", &N::mode, oneOf({"localise", "extend"}), "",
+          "localise: the bundle stays fixed, the pose in it is published; extend: also, the loop closer's saved bundle joins the run to it")
+     .nest(&N::extend, bundleExtendConfigTable());
     return t;
   }();
   return table;

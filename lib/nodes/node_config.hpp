@@ -12,6 +12,7 @@
 #pragma once
 
 #include "core/config_table.hpp"
+#include "map/bundle_extend.hpp"
 #include "runtime/node.hpp"
 
 #include <map>
@@ -45,11 +46,14 @@ struct LoopCloserNodeConfig {
   int checkpoint_keyframes = 10;  // key "loop.node.checkpoint_keyframes": keyframes between checkpoints (0 = never)
 };
 
-// Keys "reloc.prior_map" and "reloc.mode": the map bundle a run relocalises in (issue 18; "" = none, the run
-// maps from scratch) and what it does there (localise: the bundle stays fixed; extend is not built yet).
+// Keys "reloc.prior_map", "reloc.mode" and "reloc.extend.*": the map bundle a run relocalises in (issue 18;
+// "" = none, the run maps from scratch) and what it does there. localise: the bundle stays fixed. extend: the
+// run's own map (the loop closer's) is also joined to the bundle when it saves one (map/bundle_extend.hpp).
 struct RelocNodeConfig {
   std::string prior_map;
   std::string mode = "localise";
+  BundleExtendConfig extend;
+  bool extending() const { return mode == "extend" && !prior_map.empty(); }
 };
 
 // Section `input`: the bus input checks every node applies (runtime/node.hpp InputChecks, msg/validate.hpp

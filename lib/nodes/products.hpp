@@ -7,6 +7,10 @@
 #include <string>
 #include <vector>
 
+namespace adit {
+struct MapBundle;
+}
+
 namespace adit::nodes {
 
 class WritesProducts {
@@ -24,8 +28,9 @@ class WritesProducts {
 class WritesBundle {
  public:
   virtual ~WritesBundle() = default;
-  // Writes the bundle folder atomically; throws std::runtime_error naming what failed.
-  virtual void writeBundle(const std::string& dir) = 0;
+  // The run as a bundle (joined to the saved map when extending one); throws std::runtime_error naming what
+  // failed. map/map_bundle.hpp writeMapBundle writes it.
+  virtual MapBundle mapBundle() = 0;
 };
 
 }  // namespace adit::nodes

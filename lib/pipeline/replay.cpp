@@ -1,6 +1,7 @@
 #include "pipeline/replay.hpp"
 
 #include "io/atomic_file.hpp"
+#include "map/map_bundle.hpp"
 #include "msg/convert.hpp"
 #include "msg/encode.hpp"
 #include "msg/type_name.hpp"
@@ -73,23 +74,20 @@ std::string timingJson(const ReplayReport& r) {
 
 // Every requested stage, in pipeline order.
 std::vector<std::unique_ptr<runtime::Node>> buildNodes(const ReplayOptions& options, ReplayReport& report) {
+  // Every stage is told the bundle: the relocaliser relocalises in it, a loop closer extending it joins it.
+  Config config = options.config;
+  if (!options.prior_map.empty()) config.set("reloc.prior_map", options.prior_map);
   std::vector<std::unique_ptr<runtime::Node>> nodes;
-  for (const auto& name : nodes::pipelineNodeNames()) {
-    if (!options.stages.empty() && std::find(options.stages.begin(), options.stages.end(), name) == options.stages.end())
-      continue;
-    nodes.push_back(nodes::makeNode(name, options.config));
+  const auto add = [&](const std::string& name) {
+    nodes.push_back(nodes::makeNode(name, config));
     nodes.back()->timing().setCapacity(0);  // keep every sample for timing.json
     nodes.back()->cpuTiming().setCapacity(0);
     report.stages_run.push_back(name);
-  }
-  if (!options.prior_map.empty()) {
-    Config config = options.config;
-    config.set("reloc.prior_map", options.prior_map);
-    nodes.push_back(nodes::makeNode("relocaliser", config));
-    nodes.back()->timing().setCapacity(0);
-    nodes.back()->cpuTiming().setCapacity(0);
-    report.stages_run.push_back("relocaliser");
-  }
+  };
+  for (const auto& name : nodes::pipelineNodeNames())
+    if (options.stages.empty() || std::find(options.stages.begin(), options.stages.end(), name) != options.stages.end())
+      add(name);
+  if (!options.prior_map.empty()) add("relocaliser");
   // Only the last map writer's map.pcd is kept (writeProducts below): the others need not build one.
   bool map_written_later = false;
   for (auto it = nodes.rbegin(); it != nodes.rend(); ++it) {
@@ -141,7 +139,7 @@ void writeBundle(const std::vector<std::unique_ptr<runtime::Node>>& nodes, const
                  std::vector<std::string>& products) {
   for (auto it = nodes.rbegin(); it != nodes.rend(); ++it) {
     if (auto* writer = dynamic_cast<nodes::WritesBundle*>(it->get())) {
-      writer->writeBundle(dir);
+      writeMapBundle(writer->mapBundle(), dir);
       products.push_back(dir);
       return;
     }

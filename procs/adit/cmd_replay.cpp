@@ -1,5 +1,5 @@
 // adit replay <log> -o <out_dir> [--config FILE] [--record REGEX | --record-all] [--save-bundle DIR]
-//             [--prior-map BUNDLE]
+//             [--prior-map BUNDLE [--extend]]
 #include "commands.hpp"
 
 #include "map/map_bundle.hpp"
@@ -11,6 +11,7 @@
 #include <spdlog/spdlog.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdio>
 
 namespace {
@@ -27,11 +28,13 @@ struct ReplayArgs {
   bool no_progress = false;
   std::string save_bundle;
   std::string prior_map;
+  bool extend = false;
 };
 
 // A bundle the run cannot use is an error before anything runs, naming what is wrong. Localising keeps the
-// bundle fixed: without --stages the loop closer (whose keyframes grow with the run) is left out.
-void checkPriorMap(const std::string& dir, adit::pipeline::ReplayOptions& options) {
+// bundle fixed: without --stages the loop closer (whose keyframes grow with the run) is left out; extending
+// needs it (its map is what joins the bundle).
+void checkPriorMap(const std::string& dir, bool extend, adit::pipeline::ReplayOptions& options) {
   try {
     const adit::BundleSummary summary = adit::readBundleSummary(dir);
     const std::string mismatch = adit::bundleSensorMismatch(summary, adit::nodes::pipelineConfigKeys(options.config));
@@ -40,6 +43,8 @@ void checkPriorMap(const std::string& dir, adit::pipeline::ReplayOptions& option
     throw std::runtime_error("--prior-map " + dir + " cannot be used: " + e.what());
   }
   if (options.stages.empty()) options.stages = {"feature", "odometry", "mapper"};
+  if (extend && std::find(options.stages.begin(), options.stages.end(), "loop_closer") == options.stages.end())
+    options.stages.push_back("loop_closer");
 }
 
 }  // namespace
@@ -67,6 +72,9 @@ void registerReplayCommand(CLI::App& app) {
                   "Start in this map bundle with no initial guess: relocalise (Scan Context + ICP), then publish the "
                   "pose in its frame (POSE_IN_MAP, map_trajectory.tum, relocalisation.json). Mode reloc.mode "
                   "(localise: the bundle stays fixed; the loop closer is not run unless --stages names it)");
+  cmd->add_flag("--extend", args->extend,
+                "With --prior-map and --save-bundle (reloc.mode extend): the saved bundle is the prior map joined with "
+                "this run's new roadway (roadway both hold is kept once, from the prior map)");
   cmd->add_flag("--no-progress", args->no_progress, "No progress bar even on a terminal");
   cmd->callback([args] {
     adit::pipeline::ReplayOptions options;
@@ -76,7 +84,12 @@ void registerReplayCommand(CLI::App& app) {
     options.stages = args->stages;
     options.save_bundle = args->save_bundle;
     options.prior_map = args->prior_map;
-    if (!args->prior_map.empty()) checkPriorMap(args->prior_map, options);
+    if (args->extend) {
+      if (args->prior_map.empty() || args->save_bundle.empty())
+        throw CLI::ValidationError("--extend", "needs --prior-map (the map to extend) and --save-bundle (where both go)");
+      options.config.set("reloc.mode", "extend");
+    }
+    if (!args->prior_map.empty()) checkPriorMap(args->prior_map, args->extend, options);
     options.record = args->record_all ? ".*" : args->record;
     options.record_poses = args->record_all ? "" : args->record_poses;
     if (!args->no_progress && ::isatty(STDERR_FILENO)) options.on_progress = drawProgress;

@@ -243,3 +243,16 @@ TEST_F(Cli, DemoEndsWithAReportAndPlots) {
   EXPECT_LT(std::stod(report.substr(at + 17)), 0.06) << report;
   EXPECT_NE(report.find(" 0.00 % of ", at), std::string::npos) << report;
 }
+
+// --extend joins the run to a saved map: without the map (--prior-map) or a place for the result (--save-bundle)
+// it is refused before anything runs, naming what is missing.
+TEST_F(Cli, ExtendWithoutAPriorMapOrABundleToSaveIsRefused) {
+  for (const std::string& missing : {std::string(" --save-bundle ") + (dir_ / "joined").string(), std::string(" --prior-map ") + dir_.string()}) {
+    const fs::path out = dir_ / "extend_refused";
+    EXPECT_NE(run(bin("adit") + " replay " + log_.string() + " --extend" + missing + " -o " + out.string(), dir_ / "extend.txt"), 0);
+    const std::string report = slurp(dir_ / "extend.txt");
+    EXPECT_NE(report.find("needs --prior-map"), std::string::npos) << report;
+    EXPECT_FALSE(fs::exists(out / "output.lcmlog"));
+    EXPECT_FALSE(fs::exists(dir_ / "joined"));
+  }
+}

@@ -157,6 +157,16 @@ TEST(LaunchFiles, RobotFilesIncludeTheLivePipelineWithTheirSensor) {
   EXPECT_EQ(command.front(), "adit-relocaliser");
   EXPECT_EQ(command.back(), "reloc.prior_map=saved/bundle");
   EXPECT_THROW(adit::launch::loadLaunchFile(dir + "localise.launch.yaml", vars), std::runtime_error);
+  // extend.launch.yaml: the same, with the loop closer (in its place) and the relocaliser told to extend it.
+  const auto extend = adit::launch::loadLaunchFile(dir + "extend.launch.yaml", with_map);
+  ASSERT_EQ(extend.processes.size(), localise.processes.size());
+  for (const auto& p : extend.processes) {
+    if (p.name != "loop-closer" && p.name != "relocaliser") continue;
+    ASSERT_GE(p.command.size(), 4u);
+    EXPECT_EQ(p.command[p.command.size() - 3], "reloc.prior_map=saved/bundle") << p.name;
+    EXPECT_EQ(p.command.back(), "reloc.mode=extend") << p.name;
+  }
+  EXPECT_EQ(extend.processes[3].name, "loop-closer");
 
   std::ofstream(tmp + "base.launch.yaml") << "name: base\nprocesses:\n  - {name: x, command: [sleep, '1']}\n  - {name: y, command: [true]}\n";
   std::ofstream(tmp + "over.launch.yaml") << "include: base.launch.yaml\nprocesses:\n  - {name: x, command: [sleep, '2']}\n";
