@@ -22,7 +22,7 @@ from concurrent.futures import ThreadPoolExecutor
 import numpy as np
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-ADIT = os.path.join(ROOT, "build", "bin", "adit")
+ADIT = os.environ.get("ADIT_BIN", os.path.join(ROOT, "build", "bin", "adit"))  # another build: ADIT_BIN
 OUT = os.path.join(ROOT, "logs", "bench-reloc")
 
 

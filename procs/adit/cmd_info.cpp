@@ -2,10 +2,12 @@
 // and bandwidth (MB/s over the whole log's span, i.e. what the channel costs the bus and the disk), and the
 // whole log's rate.
 // adit info <file.bag>: a ROS 1 bag's topics, types, message counts, span and rate, and any lost chunk.
-// adit info <bundle folder>: a map bundle's date, keyframes, extent, roadway length, sensor keys and files
-// (every file's size and checksum are checked; a bad bundle is an error naming what is wrong).
+// adit info <bundle folder> [--keyframes FILE]: a map bundle's date, keyframes, extent, roadway length, sensor
+// keys and files (every file's size and checksum are checked; a bad bundle is an error naming what is wrong);
+// the keyframes' poses as TUM into FILE.
 #include "commands.hpp"
 
+#include "eval/trajectory_io.hpp"
 #include "io/rosbag.hpp"
 #include "map/map_bundle.hpp"
 #include "msg/type_name.hpp"
@@ -60,10 +62,16 @@ void printBagSummary(const std::string& path) {
   }
 }
 
-void printBundleSummary(const std::string& dir) {
+// keyframes_tum: also write the keyframes' poses (map frame) there as TUM, to plot or compare with a truth.
+void printBundleSummary(const std::string& dir, const std::string& keyframes_tum) {
   adit::BundleSummary s;
   try {
     s = adit::readBundleSummary(dir);
+    if (!keyframes_tum.empty()) {
+      adit::Trajectory poses;
+      for (const adit::BundleKeyframe& k : adit::loadMapBundle(dir).keyframes) poses.push_back({k.utime, k.pose});
+      adit::eval::writeTum(keyframes_tum, poses);
+    }
   } catch (const adit::BundleError& e) {
     spdlog::error("bad map bundle: {}", e.what());
     throw CLI::RuntimeError(kExitDamagedInput);
@@ -86,10 +94,12 @@ void printBundleSummary(const std::string& dir) {
 
 void registerInfoCommand(CLI::App& app) {
   auto path = std::make_shared<std::string>();
+  auto keyframes_tum = std::make_shared<std::string>();
   auto* cmd = app.add_subcommand("info", "Summarise an LCM log (messages, type, time span and rate per channel), a ROS 1 bag (topics, types, counts) or a map bundle");
   cmd->add_option("log", *path, "LCM log, ROS bag or map bundle folder")->required()->check(CLI::ExistingPath);
-  cmd->callback([path] {
-    if (std::filesystem::is_directory(*path)) return printBundleSummary(*path);
+  cmd->add_option("--keyframes", *keyframes_tum, "Map bundle: also write its keyframes' poses (map frame) to this TUM file");
+  cmd->callback([path, keyframes_tum] {
+    if (std::filesystem::is_directory(*path)) return printBundleSummary(*path, *keyframes_tum);
     if (isRosbag(*path)) return printBagSummary(*path);
     adit::runtime::LogReader reader(*path);
     std::map<std::string, ChannelStats> channels;

@@ -256,3 +256,22 @@ TEST_F(Cli, ExtendWithoutAPriorMapOrABundleToSaveIsRefused) {
     EXPECT_FALSE(fs::exists(dir_ / "joined"));
   }
 }
+
+// A run saved as a map bundle is summarised by `adit info`, which also writes its keyframes' poses as TUM.
+TEST_F(Cli, InfoSummarisesABundleAndWritesItsKeyframes) {
+  const fs::path bundle = dir_ / "bundle", out = dir_ / "bundle_run", tum = dir_ / "keyframes.tum";
+  ASSERT_EQ(run(bin("adit") + " replay " + log_.string() + " --no-progress --config " ADIT_SOURCE_DIR
+                    "/launch/sensors/hdl64.yaml --save-bundle " + bundle.string() + " -o " + out.string(), dir_ / "bundle.txt"), 0)
+      << slurp(dir_ / "bundle.txt");
+  ASSERT_EQ(run(bin("adit") + " info " + bundle.string() + " --keyframes " + tum.string(), dir_ / "info.txt"), 0)
+      << slurp(dir_ / "info.txt");
+  const std::string info = slurp(dir_ / "info.txt");
+  const auto at = info.find("\n  keyframes");
+  ASSERT_NE(at, std::string::npos) << info;
+  const int keyframes = std::stoi(info.substr(info.find_first_of("0123456789", at)));
+  EXPECT_GT(keyframes, 0);
+  std::istringstream lines(slurp(tum));
+  int poses = 0;
+  for (std::string line; std::getline(lines, line);) poses += !line.empty() && line[0] != '#';
+  EXPECT_EQ(poses, keyframes);
+}
