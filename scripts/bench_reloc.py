@@ -13,7 +13,9 @@ own drift. Time to first fix: sensor time from the first sweep, and the relocali
 Inside = the drive starts within 3 m of the mapped path; outside = every pose of the drive is > 40 m from it.
 
   scripts/bench_reloc.py [--worlds W ...] [--drives 50] [--outside 10] [--duration 20] [--map-duration 200] [--jobs 2]
-                         [--keep-map] [--judge-only]
+                         [--keep-map] [--judge-only] [--start-pose-error M DEG]
+With --start-pose-error each drive is told its start pose (adit replay --start-pose), off by up to M metres and
+DEG degrees: the operator's guess, which lets a self-similar map (room-and-pillar) fix near it.
 Needs a build (build/bin/adit) and numpy (Debian python3-numpy: run with /usr/bin/python3). Keeps its runs in
 logs/bench-reloc/ and prints a Markdown table.
 """
@@ -75,15 +77,30 @@ def map_world(world, duration, seed, build=True):
     return {"dir": d, "positions": positions, "anchors": anchors, "route_m": route}
 
 
-def short_drive(world, m, seed, index, start, reverse, duration, configs=()):
+def start_pose_args(m, truth_start, rng, error):
+    """--start-pose: the drive's true start in the map frame, off by up to error = (metres, degrees)."""
+    nearest = int(np.argmin(np.linalg.norm(m["positions"] - truth_start[:3, 3], axis=1)))
+    T = np.linalg.inv(m["anchors"][nearest]) @ truth_start
+    angle = rng.uniform(0, 2 * math.pi)
+    dist = rng.uniform(0, error[0])
+    x, y, z = T[0, 3] + dist * math.cos(angle), T[1, 3] + dist * math.sin(angle), T[2, 3]
+    heading = math.degrees(math.atan2(T[1, 0], T[0, 0])) + rng.uniform(-error[1], error[1])
+    return ["--start-pose", f"{x:.3f}", f"{y:.3f}", f"{z:.3f}", f"{heading:.2f}"]
+
+
+def short_drive(world, m, seed, index, start, reverse, duration, configs=(), start_error=None):
     d = os.path.join(m["dir"], f"drive{index:03d}")
     os.makedirs(d, exist_ok=True)
     log, gt = os.path.join(d, "in.lcmlog"), os.path.join(d, "gt.tum")
     args = ["sim", "--world", world, "--duration", str(duration), "--seed", str(seed), "--start-distance", f"{start:.1f}",
             "-o", log, "--gt", gt]
     run(args + (["--reverse"] if reverse else []))
+    hint = []
+    if start_error:
+        truth = read_tum(gt)
+        hint = start_pose_args(m, truth[min(truth)], random.Random(seed * 1000 + index), start_error)
     run(["replay", log, "-o", os.path.join(d, "run"), "--prior-map", os.path.join(m["dir"], "bundle"), "--no-progress",
-         "--record", "^$"] + (["--config"] + list(configs) if configs else []))
+         "--record", "^$"] + (["--config"] + list(configs) if configs else []) + hint)
     os.remove(log)
     return judge(m, d, index, start, reverse)
 
@@ -167,6 +184,8 @@ def main():
     p.add_argument("--keep-map", action="store_true", help="reuse the mapping drives already in logs/bench-reloc")
     p.add_argument("--out", default=None, help="folder of the runs (default logs/bench-reloc)")
     p.add_argument("--config", nargs="+", default=[], help="configuration files for the short drives' replays")
+    p.add_argument("--start-pose-error", nargs=2, type=float, default=None, metavar=("M", "DEG"),
+                   help="give each drive its start pose (--start-pose), off by up to M metres and DEG degrees")
     a = p.parse_args()
     OUT = os.path.abspath(a.out) if a.out else OUT
     if a.judge_only:
@@ -188,7 +207,8 @@ def main():
         plan = starts(rng, m, a.drives, outside, mapped)
         with ThreadPoolExecutor(a.jobs) as pool:
             results = list(pool.map(lambda ia: short_drive(world, m, a.seed, ia[0], ia[1][0], ia[1][1], a.duration,
-                                                                [os.path.abspath(c) for c in a.config]),
+                                                                [os.path.abspath(c) for c in a.config],
+                                                                a.start_pose_error),
                                     enumerate(plan)))
         json.dump(results, open(os.path.join(m["dir"], "results.json"), "w"), indent=1)
         print(f"{world}: mapped {mapped:.0f} m of a {m['route_m']} m route; {len(results)} drives", file=sys.stderr)

@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <memory>
 #include <string>
 
@@ -36,7 +37,25 @@ const ConfigTable<RelocaliserConfig>& relocaliserConfigTable() {
      .add("self_similar_candidates", &R::self_similar_candidates, between(1, 10000), "", "Scan Context candidates ranked when looking for that other place")
      .add("self_similar_samples", &R::self_similar_samples, between(1, 1000), "keyframes", "keyframes spread over the map checked to judge whether the whole map repeats itself")
      .add("self_similar_map_ratio", &R::self_similar_map_ratio, between(0, 1), "", "share of them that must repeat for every fix in the map to be refused")
-     .nest(&R::axial, axialSearchConfigTable());
+     .add("lost_search_distance", &R::lost_search_distance, atLeast(0), "m", "lost after a fix: driving during which the search stays near the last fix carried on (0 = the whole map at once)")
+     .nest(&R::axial, axialSearchConfigTable())
+     .nest(&R::start, poseHintConfigTable());
+    return t;
+  }();
+  return table;
+}
+
+const ConfigTable<PoseHintConfig>& poseHintConfigTable() {
+  using H = PoseHintConfig;
+  static const ConfigTable<H> table = [] {
+    ConfigTable<H> t("reloc.start");
+    t.add("given", &H::given, anyValue(), "", "the run starts near the pose below (x, y, z, heading_deg in the bundle's frame): relocalise only there")
+     .add("x", &H::x, anyValue(), "m", "start position in the map frame")
+     .add("y", &H::y, anyValue(), "m", "start position in the map frame")
+     .add("z", &H::z, anyValue(), "m", "start position in the map frame")
+     .add("heading_deg", &H::heading_deg, between(-360, 360), "deg", "start heading (yaw about the map's z axis)")
+     .add("radius", &H::radius, above(0), "m", "how far from the start pose (and, when lost, from the last fix carried on) the robot may be")
+     .add("yaw_tolerance_deg", &H::yaw_tolerance_deg, between(0, 180), "deg", "heading error the start pose's seeds cover");
     return t;
   }();
   return table;
@@ -58,11 +77,21 @@ Relocaliser::Relocaliser(MapBundle bundle, const LoopCloserConfig& loop, const R
     alias_database_.add(k.context, k.utime);
   }
   // The judgement reads only the bundle, the databases and the configuration, none of which change from here.
+  if (config_.start.given) {
+    Eigen::Isometry3d start = Eigen::Isometry3d::Identity();
+    start.translation() = Eigen::Vector3d(config_.start.x, config_.start.y, config_.start.z);
+    start.linear() = Eigen::AngleAxisd(config_.start.heading_deg * M_PI / 180.0, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    setPoseHint(start, config_.start.radius);
+  }
   if (config_.refuse_self_similar) map_judgement_ = std::async(std::launch::async, [this] { return judgeMap(); });
 }
 
 Relocaliser::~Relocaliser() {
   if (map_judgement_.valid()) map_judgement_.wait();
+}
+
+void Relocaliser::setPoseHint(const Eigen::Isometry3d& T_map_lidar, double radius) {
+  next_hint_ = std::make_pair(T_map_lidar, radius);
 }
 
 Relocaliser::Result Relocaliser::process(const PoseEstimate& session, const std::vector<Eigen::Vector3f>& cloud,
@@ -77,6 +106,13 @@ Relocaliser::Result Relocaliser::process(const PoseEstimate& session, const std:
   have_last_ = true;
   last_pose_ = session.pose;
   last_utime_ = session.utime;
+  if (next_hint_) {  // a given place: relocalise there from this sweep, whatever the state
+    if (state_ == RelocState::kLocalised) loseFix(), result.lost_now = true;
+    hint_ = Hint{next_hint_->first * session.pose.inverse(), next_hint_->second, std::numeric_limits<double>::infinity(),
+                 std::numeric_limits<int>::max()};
+    next_hint_.reset();
+    pending_.clear();
+  }
   if (stalled || registration_failed) recent_.clear();  // the session's motion across the gap is not trusted
   recent_.emplace_back(session.pose, cloud);
   while (static_cast<int>(recent_.size()) > config_.query_sweeps) recent_.pop_front();
@@ -97,6 +133,10 @@ Relocaliser::Result Relocaliser::process(const PoseEstimate& session, const std:
 
 void Relocaliser::loseFix() {
   state_ = RelocState::kRelocalising;
+  // Near where the last fix, carried on by the odometry, puts the robot: searched there first.
+  if (config_.lost_search_distance > 0)
+    hint_ = Hint{T_map_session_, config_.start.radius, travelled_ + config_.lost_search_distance,
+                 static_cast<int>(std::ceil(config_.lost_search_distance / config_.query_distance))};
   pending_.clear();
   track_failures_ = 0;
   last_query_travelled_ = -1e9;
@@ -104,6 +144,8 @@ void Relocaliser::loseFix() {
 }
 
 void Relocaliser::relocalise(const PoseEstimate& session, Result& result) {
+  // Not found near it within its distance or queries (standing still): the whole map again.
+  if (hint_ && (travelled_ > hint_->until_travelled || hint_->queries_left <= 0)) hint_.reset();
   const bool due = travelled_ - last_query_travelled_ >= config_.query_distance ||
                    static_cast<double>(session.utime - last_query_utime_) * 1e-6 >= config_.query_interval_s;
   if (!due) return;
@@ -129,6 +171,7 @@ void Relocaliser::relocalise(const PoseEstimate& session, Result& result) {
                                session.pose.inverse());
   state_ = RelocState::kLocalised;
   pending_.clear();
+  hint_.reset();
   track_failures_ = 0;
   ++stats_.fixes;
   result.fixed_now = true;
@@ -180,13 +223,14 @@ std::optional<Relocaliser::Fix> Relocaliser::query(const PoseEstimate& session, 
 // degeneracy test refuses nearly every single-sweep fit on a straight, and a fit it accepts can still be one of
 // several along a repeating roadway.
 LoopVerification Relocaliser::verify(const PlaneTarget& target, const std::vector<Eigen::Vector3f>& source,
-                                     const Eigen::Isometry3d& seed, AxialSearchResult& search, RelocStats& stats) const {
+                                     const std::vector<Eigen::Isometry3d>& seeds, const AxialSearchConfig& axial,
+                                     AxialSearchResult& search, RelocStats& stats) const {
   ++stats.verified;
-  LoopVerification v = verifyLoopAgainst(target, source, {seed}, loop_.verifier);
+  LoopVerification v = verifyLoopAgainst(target, source, seeds, loop_.verifier);
   const bool tight = v.verdict == LoopVerdict::kDegenerate || v.verdict == LoopVerdict::kAccepted;
-  if (!tight || !config_.axial.enabled) return v;
+  if (!tight || !axial.enabled) return v;
   ++stats.axial_searches;
-  search = searchWeakDirection(target, source, v.icp, loop_.verifier, config_.axial);
+  search = searchWeakDirection(target, source, v.icp, loop_.verifier, axial);
   if (std::string(search.refusal) == "ambiguous") ++stats.axial_ambiguous;
   if (!search.resolved) {
     // Refused, but its line's best place is what another candidate's fit must beat (the ambiguity test).
@@ -204,11 +248,60 @@ LoopVerification Relocaliser::verify(const PlaneTarget& target, const std::vecto
   return v;
 }
 
+// The best Scan Context candidates, each seeded by its yaw.
+std::vector<Relocaliser::Candidate> Relocaliser::scanContextCandidates(const PoseEstimate& session,
+                                                                       const std::vector<Eigen::Vector3f>& cloud) const {
+  std::vector<Candidate> out;
+  const ScanContext context = keyframeScanContext(cloud, session.pose, loop_.level_scan_context, loop_.scan_context);
+  if (context.empty()) return out;
+  for (const ScanContextCandidate& c : database_.query(context, 0)) {
+    if (c.distance > loop_.max_scan_context_distance || static_cast<int>(out.size()) >= config_.max_verifications) break;
+    const BundleKeyframe& match = bundle_.keyframes[static_cast<std::size_t>(c.index)];
+    out.push_back({c.index, {scanContextSeed(session.pose, match.pose, c.yaw, loop_.level_scan_context)}});
+  }
+  return out;
+}
+
+// The bundle keyframes within the hint's radius of the guess, nearest first, seeded by the guess and the guess
+// turned by +-yaw_tolerance_deg.
+std::vector<Relocaliser::Candidate> Relocaliser::hintedCandidates(const Eigen::Isometry3d& guess) const {
+  std::vector<std::pair<double, int>> near;
+  for (std::size_t k = 0; k < bundle_.keyframes.size(); ++k) {
+    const double d = (bundle_.keyframes[k].pose.translation() - guess.translation()).norm();
+    if (d <= hint_->radius) near.emplace_back(d, static_cast<int>(k));
+  }
+  std::sort(near.begin(), near.end());
+  const double tolerance = config_.start.yaw_tolerance_deg * M_PI / 180.0;
+  std::vector<Candidate> out;
+  for (const auto& [distance, k] : near) {
+    if (static_cast<int>(out.size()) >= config_.max_verifications) break;
+    Candidate c{k, {}};
+    for (const double yaw : {0.0, tolerance, -tolerance}) {
+      Eigen::Isometry3d turned = guess;
+      turned.linear() = Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix() * guess.linear();
+      c.seeds.push_back(bundle_.keyframes[static_cast<std::size_t>(k)].pose.inverse() * turned);
+      if (tolerance <= 0.0) break;
+    }
+    out.push_back(std::move(c));
+  }
+  return out;
+}
+
 std::optional<Relocaliser::Fix> Relocaliser::bestFix(const PoseEstimate& session, const std::vector<Eigen::Vector3f>& cloud,
                                                      RelocQueryRecord& record) {
   record.outcome = "no_candidate";
-  const ScanContext context = keyframeScanContext(cloud, session.pose, loop_.level_scan_context, loop_.scan_context);
-  if (context.empty() || database_.size() == 0) return std::nullopt;
+  if (database_.size() == 0) return std::nullopt;
+  // Near a given place the search along a roadway stays within its radius: no twin of the place is that close.
+  const std::optional<Eigen::Isometry3d> guess =
+      hint_ ? std::optional<Eigen::Isometry3d>(hint_->T_map_session * session.pose) : std::nullopt;
+  AxialSearchConfig axial = config_.axial;
+  if (guess) {
+    axial.range = std::min(axial.range, hint_->radius);
+    ++stats_.hinted_queries;
+    --hint_->queries_left;
+  }
+  const std::vector<Candidate> candidates = guess ? hintedCandidates(*guess) : scanContextCandidates(session, cloud);
+  if (candidates.empty()) return std::nullopt;
   const std::vector<Eigen::Vector3f> source = querySource(queryCloud(session.pose).decode(), loop_.verifier);
   struct Tried {
     Fix fix;
@@ -222,24 +315,20 @@ std::optional<Relocaliser::Fix> Relocaliser::bestFix(const PoseEstimate& session
     return std::any_of(done.begin(), done.end(), [&](const Tried& t) {
       if (t.search.axis.isZero()) return false;
       const Eigen::Isometry3d& match = bundle_.keyframes[static_cast<std::size_t>(t.fix.match)].pose;
-      const Eigen::Vector3d axis = match.linear() * t.search.axis, d = at - mapPose(t.fix).translation();
-      const double along = d.dot(axis);
-      return std::abs(along) < config_.axial.range - config_.ambiguity_distance &&
-             (d - along * axis).norm() < config_.ambiguity_distance;
+      const Eigen::Vector3d line = match.linear() * t.search.axis, d = at - mapPose(t.fix).translation();
+      const double along = d.dot(line);
+      return std::abs(along) < axial.range - config_.ambiguity_distance &&
+             (d - along * line).norm() < config_.ambiguity_distance;
     });
   };
   std::vector<Tried> tried;
-  int candidates = 0;
-  for (const ScanContextCandidate& c : database_.query(context, 0)) {
-    if (c.distance > loop_.max_scan_context_distance || candidates >= config_.max_verifications) break;
-    ++candidates;
-    const BundleKeyframe& match = bundle_.keyframes[static_cast<std::size_t>(c.index)];
+  for (const Candidate& c : candidates) {
+    const BundleKeyframe& match = bundle_.keyframes[static_cast<std::size_t>(c.match)];
     if (searched(tried, match.pose.translation())) continue;
-    const std::unique_ptr<PlaneTarget> target = candidateTarget(neighbourhood(c.index), loop_.verifier);
+    const std::unique_ptr<PlaneTarget> target = candidateTarget(neighbourhood(c.match), loop_.verifier);
     Tried t;
-    t.v = verify(*target, source, scanContextSeed(session.pose, match.pose, c.yaw, loop_.level_scan_context), t.search,
-                 stats_);
-    t.fix = {c.index, t.v.T_match_query, session.pose, travelled_};
+    t.v = verify(*target, source, c.seeds, axial, t.search, stats_);
+    t.fix = {c.match, t.v.T_match_query, session.pose, travelled_};
     tried.push_back(t);
   }
   const Tried* best = nullptr;
@@ -273,7 +362,13 @@ std::optional<Relocaliser::Fix> Relocaliser::bestFix(const PoseEstimate& session
       return std::nullopt;
     }
   }
-  if (config_.refuse_self_similar && (mapSelfSimilar() || selfSimilar(mapPose(best->fix)))) {
+  if (guess && (mapPose(best->fix).translation() - guess->translation()).norm() > hint_->radius) {
+    ++stats_.rejected_far_from_hint;
+    record.outcome = "far_from_hint";
+    return std::nullopt;
+  }
+  // Near a given place a twin of it elsewhere in the map does not matter: the place was given.
+  if (!guess && config_.refuse_self_similar && (mapSelfSimilar() || selfSimilar(mapPose(best->fix)))) {
     ++stats_.rejected_self_similar;
     record.outcome = "self_similar";
     return std::nullopt;
@@ -364,8 +459,8 @@ bool Relocaliser::repeatsElsewhere(int m, RelocStats& stats) const {
     ++verified;
     const std::unique_ptr<PlaneTarget> target = candidateTarget(neighbourhood(c.index), loop_.verifier);
     AxialSearchResult search;
-    const LoopVerification v = verify(*target, source,
-                                      scanContextSeed(keyframe.pose, other.pose, c.yaw, loop_.level_scan_context), search, stats);
+    const LoopVerification v = verify(*target, source, {scanContextSeed(keyframe.pose, other.pose, c.yaw, loop_.level_scan_context)},
+                                      config_.axial, search, stats);
     const Eigen::Isometry3d at = other.pose * v.T_match_query;
     if (v.verdict == LoopVerdict::kAccepted &&
         (at.translation() - keyframe.pose.translation()).norm() > config_.ambiguity_distance)

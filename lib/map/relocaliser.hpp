@@ -28,6 +28,21 @@
 
 namespace adit {
 
+// A place the robot is known to be near: the operator's start pose (the shaft bottom, the charging bay), or
+// where the robot was when it got lost. While one is set, relocalising verifies only the bundle keyframes
+// within `radius` of it, from its heading (and +-yaw_tolerance_deg), and searches along a roadway only that
+// far: a map that repeats itself (a pillar grid) has no twin of a place that close, so such a fix is not
+// refused as self-similar. A fix farther than `radius` from it is refused.
+struct PoseHintConfig {
+  bool given = false;  // reloc.start.given: the start pose below is where the run starts (its first sweep)
+  double x = 0.0, y = 0.0, z = 0.0;  // m, map frame
+  double heading_deg = 0.0;          // yaw about the map's z axis
+  double radius = 5.0;               // m: how far from it the robot may be
+  double yaw_tolerance_deg = 20.0;   // the heading's error the seeds cover
+};
+
+const ConfigTable<PoseHintConfig>& poseHintConfigTable();
+
 struct RelocaliserConfig {
   int candidates = 25;           // ring-key neighbours ranked by Scan Context distance per query
   int max_verifications = 4;     // best candidates verified by ICP per query
@@ -61,6 +76,10 @@ struct RelocaliserConfig {
   double self_similar_map_ratio = 0.5;  // share of them that must repeat for the map to count as self-similar
   // A query's fit that is tight but weak along the roadway is searched along it (map/axial_search.hpp).
   AxialSearchConfig axial;
+  PoseHintConfig start;
+  // Lost after a fix: for this much driving the search stays within start.radius of where the odometry says
+  // the robot is (the last fix carried on), then covers the whole map again (0: the whole map at once).
+  double lost_search_distance = 20.0;
 };
 
 const ConfigTable<RelocaliserConfig>& relocaliserConfigTable();
@@ -85,6 +104,8 @@ struct RelocStats {
   int lost = 0;
   int track_verified = 0, track_failed = 0;
   int track_degenerate = 0;     // fits but constrains too few directions: kept, not a failure
+  int hinted_queries = 0;       // queries searched near a given place (the start pose, the pose when lost)
+  int rejected_far_from_hint = 0;  // ... whose fit landed farther than its radius from it
 };
 
 // One relocalising query, for the benchmark's diagnosis (relocaliser's products): what it found and why it was
@@ -113,6 +134,10 @@ class Relocaliser {
     bool anchored_now = false;
     std::optional<Eigen::Isometry3d> T_map_lidar;  // only when localised
   };
+  // The robot is near this map pose at the next sweep processed (the operator's start pose; reloc.start sets
+  // one at construction): relocalising searches only within `radius` of it until the fix. Replaces any other.
+  void setPoseHint(const Eigen::Isometry3d& T_map_lidar, double radius);
+
   // session: the run's own pose (mapper output) of the sweep; cloud: its deskewed points, lidar frame.
   Result process(const PoseEstimate& session, const std::vector<Eigen::Vector3f>& cloud, bool registration_failed);
 
@@ -137,9 +162,17 @@ class Relocaliser {
   bool track(const PoseEstimate& session);  // true when a tracking fit refined the pose
   std::optional<Fix> query(const PoseEstimate& session, const std::vector<Eigen::Vector3f>& cloud);
   std::optional<Fix> bestFix(const PoseEstimate& session, const std::vector<Eigen::Vector3f>& cloud, RelocQueryRecord& record);
-  // ICP with the search along a weak direction; counts into `stats` (the background judgement has its own).
+  // ICP from the seeds (the first that fits) with the search along a weak direction; counts into `stats` (the
+  // background judgement has its own).
   LoopVerification verify(const PlaneTarget& target, const std::vector<Eigen::Vector3f>& source,
-                          const Eigen::Isometry3d& seed, AxialSearchResult& search, RelocStats& stats) const;
+                          const std::vector<Eigen::Isometry3d>& seeds, const AxialSearchConfig& axial,
+                          AxialSearchResult& search, RelocStats& stats) const;
+  struct Candidate {
+    int match = -1;
+    std::vector<Eigen::Isometry3d> seeds;  // T_match_query
+  };
+  std::vector<Candidate> scanContextCandidates(const PoseEstimate& session, const std::vector<Eigen::Vector3f>& cloud) const;
+  std::vector<Candidate> hintedCandidates(const Eigen::Isometry3d& guess) const;
   bool consistent(const Fix& a, const Fix& b) const;
   bool selfSimilar(const Eigen::Isometry3d& T_map_lidar);
   int nearestKeyframe(const Eigen::Vector3d& position) const;
@@ -164,6 +197,14 @@ class Relocaliser {
   RelocState state_ = RelocState::kRelocalising;
   Eigen::Isometry3d T_map_session_ = Eigen::Isometry3d::Identity();
   std::vector<Fix> pending_;
+  struct Hint {
+    Eigen::Isometry3d T_map_session = Eigen::Isometry3d::Identity();
+    double radius = 0.0;
+    double until_travelled = 0.0;  // dropped once the session has driven this far
+    int queries_left = 0;          // ... or after this many queries (a robot standing still)
+  };
+  std::optional<Hint> hint_;
+  std::optional<std::pair<Eigen::Isometry3d, double>> next_hint_;  // T_map_lidar and radius, for the next sweep
   RelocStats stats_;
   std::vector<RelocQueryRecord> query_log_;
   // Session motion bookkeeping.

@@ -11,9 +11,14 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include <adit/command_t.hpp>
+
 #include <chrono>
+#include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <optional>
+#include <sstream>
 
 namespace adit::nodes {
 namespace {
@@ -22,6 +27,8 @@ class RelocaliserNode : public runtime::Node, public WritesProducts {
  public:
   explicit RelocaliserNode(const Config& config) : Node("relocaliser") {
     subscribe<adit::odometry_t>("mapped", "ODOM_MAPPED", [this](const adit::odometry_t& m) { onMapped(m); });
+    subscribe<adit::command_t>("command", "RELOC_COMMAND", [this](const adit::command_t& m) { onCommand(m); },
+                               runtime::InputKind::Requests);
     advertise("pose", "POSE_IN_MAP");
     const RelocNodeConfig node = relocNodeConfigTable().read(config);
     if (node.prior_map.empty()) return;  // no bundle asked for: the run maps from scratch
@@ -29,7 +36,9 @@ class RelocaliserNode : public runtime::Node, public WritesProducts {
       MapBundle bundle = loadMapBundle(node.prior_map);
       const std::string mismatch = bundleSensorMismatch(bundle.summary, pipelineConfigKeys(config));
       if (!mismatch.empty()) throw BundleError(node.prior_map + ": " + mismatch);
-      relocaliser_.emplace(std::move(bundle), loopCloserConfigFrom(config), relocaliserConfigTable().read(config));
+      const RelocaliserConfig reloc = relocaliserConfigTable().read(config);
+      start_radius_ = reloc.start.radius;
+      relocaliser_.emplace(std::move(bundle), loopCloserConfigFrom(config), reloc);
       spdlog::info("[relocaliser] map bundle {}: {} keyframes, {:.0f} m of roadway", node.prior_map,
                    relocaliser_->bundle().summary.keyframes, relocaliser_->bundle().summary.roadway_length_m);
     } catch (const BundleError& e) {
@@ -53,6 +62,43 @@ class RelocaliserNode : public runtime::Node, public WritesProducts {
   }
 
  private:
+  // set_pose "X Y Z HEADING_DEG [RADIUS]": the robot is near this pose of the map now (the operator's guess);
+  // relocalise only within RADIUS of it (default reloc.start.radius). Anyone on the bus can send it: signed
+  // commands only, with a key (README "Commands are safe to receive").
+  void onCommand(const adit::command_t& m) {
+    if (!commandAuthentic("command", m)) return;
+    if (m.command != "set_pose") {
+      reportError("unknown_command", "unknown command '" + runtime::printableText(m.command) + "' (known: set_pose)");
+      return;
+    }
+    std::vector<double> v;
+    bool numbers = true;
+    std::istringstream in(m.argument);
+    for (std::string word; in >> word;) {
+      char* end = nullptr;
+      v.push_back(std::strtod(word.c_str(), &end));
+      numbers = numbers && end != word.c_str() && *end == '\0' && std::isfinite(v.back());
+    }
+    const double radius = v.size() == 5 ? v[4] : start_radius_;
+    if (!numbers || (v.size() != 4 && v.size() != 5) || radius <= 0) {
+      reportError("command_refused", "set_pose '" + runtime::printableText(m.argument) +
+                                         "' refused: expected X Y Z HEADING_DEG [RADIUS], finite, RADIUS > 0");
+      return;
+    }
+    const double x = v[0], y = v[1], z = v[2], heading_deg = v[3];
+    if (!relocaliser_) {
+      reportError("command_refused", "set_pose: no map bundle to place the pose in");
+      return;
+    }
+    Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+    pose.translation() = Eigen::Vector3d(x, y, z);
+    pose.linear() = Eigen::AngleAxisd(heading_deg * M_PI / 180.0, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    relocaliser_->setPoseHint(pose, radius);
+    count("poses_set");
+    spdlog::info("[relocaliser] told it is within {:.1f} m of ({:.1f}, {:.1f}, {:.1f}), heading {:.0f} deg", radius, x, y, z,
+                 heading_deg);
+  }
+
   void onMapped(const adit::odometry_t& m) {
     if (!relocaliser_) return;
     const PoseEstimate session = msg::fromMessage(m);
@@ -89,6 +135,8 @@ class RelocaliserNode : public runtime::Node, public WritesProducts {
     setCount("rejected_self_similar", s.rejected_self_similar);
     setCount("self_similar_map", s.self_similar_map);
     setCount("track_failed", s.track_failed);
+    setCount("hinted_queries", s.hinted_queries);
+    setCount("rejected_far_from_hint", s.rejected_far_from_hint);
   }
 
   // Every relocalising query: its outcome and best fit in the map frame (TUM pose), for diagnosis.
@@ -113,12 +161,14 @@ class RelocaliserNode : public runtime::Node, public WritesProducts {
         "  \"first_fix_compute_ms\": {:.1f},\n  \"poses_in_map\": {},\n  \"queries\": {},\n  \"fixes\": {},\n"
         "  \"lost\": {},\n  \"rejected_fit\": {},\n  \"rejected_degenerate\": {},\n  \"rejected_ambiguous\": {},\n  \"rejected_inconsistent\": {},\n"
         "  \"rejected_self_similar\": {},\n  \"self_similarity_checks\": {},\n  \"self_similar_map\": {},\n  \"axial_searches\": {},\n  \"axial_resolved\": {},\n  \"axial_ambiguous\": {},\n"
-        "  \"track_verified\": {},\n  \"track_failed\": {},\n  \"track_degenerate\": {}\n}}\n",
+        "  \"track_verified\": {},\n  \"track_failed\": {},\n  \"track_degenerate\": {},\n  \"hinted_queries\": {},\n"
+        "  \"rejected_far_from_hint\": {}\n}}\n",
         state(), fix_s, first_fix_.value_or(0), compute_ms_, in_map_.size(), s.queries, s.fixes, s.lost, s.rejected_fit, s.rejected_degenerate,
-        s.rejected_ambiguous, s.rejected_inconsistent, s.rejected_self_similar, s.self_similarity_checks, s.self_similar_map, s.axial_searches, s.axial_resolved, s.axial_ambiguous, s.track_verified, s.track_failed, s.track_degenerate);
+        s.rejected_ambiguous, s.rejected_inconsistent, s.rejected_self_similar, s.self_similarity_checks, s.self_similar_map, s.axial_searches, s.axial_resolved, s.axial_ambiguous, s.track_verified, s.track_failed, s.track_degenerate, s.hinted_queries, s.rejected_far_from_hint);
   }
 
   std::optional<Relocaliser> relocaliser_;
+  double start_radius_ = PoseHintConfig{}.radius;
   Trajectory in_map_;
   std::int64_t first_utime_ = -1;
   std::optional<std::int64_t> first_fix_;

@@ -1,5 +1,5 @@
 // adit replay <log> -o <out_dir> [--config FILE] [--record REGEX | --record-all] [--save-bundle DIR]
-//             [--prior-map BUNDLE [--extend]]
+//             [--prior-map BUNDLE [--extend] [--start-pose X Y Z HEADING_DEG]]
 #include "commands.hpp"
 
 #include "map/map_bundle.hpp"
@@ -29,6 +29,7 @@ struct ReplayArgs {
   std::string save_bundle;
   std::string prior_map;
   bool extend = false;
+  std::vector<double> start_pose;
 };
 
 // A bundle the run cannot use is an error before anything runs, naming what is wrong. Localising keeps the
@@ -75,6 +76,10 @@ void registerReplayCommand(CLI::App& app) {
   cmd->add_flag("--extend", args->extend,
                 "With --prior-map and --save-bundle (reloc.mode extend): the saved bundle is the prior map joined with "
                 "this run's new roadway (roadway both hold is kept once, from the prior map)");
+  cmd->add_option("--start-pose", args->start_pose,
+                  "With --prior-map: the run starts near this pose of the bundle (X Y Z in m, HEADING in deg; "
+                  "reloc.start.*): relocalise only within reloc.start.radius of it")
+      ->expected(4);
   cmd->add_flag("--no-progress", args->no_progress, "No progress bar even on a terminal");
   cmd->callback([args] {
     adit::pipeline::ReplayOptions options;
@@ -88,6 +93,12 @@ void registerReplayCommand(CLI::App& app) {
       if (args->prior_map.empty() || args->save_bundle.empty())
         throw CLI::ValidationError("--extend", "needs --prior-map (the map to extend) and --save-bundle (where both go)");
       options.config.set("reloc.mode", "extend");
+    }
+    if (!args->start_pose.empty()) {
+      if (args->prior_map.empty()) throw CLI::ValidationError("--start-pose", "needs --prior-map (the map the pose is in)");
+      options.config.set("reloc.start.given", "true");
+      const char* keys[] = {"reloc.start.x", "reloc.start.y", "reloc.start.z", "reloc.start.heading_deg"};
+      for (int i = 0; i < 4; ++i) options.config.set(keys[i], fmt::format("{}", args->start_pose[static_cast<std::size_t>(i)]));
     }
     if (!args->prior_map.empty()) checkPriorMap(args->prior_map, args->extend, options);
     options.record = args->record_all ? ".*" : args->record;

@@ -137,3 +137,34 @@ TEST(Commands, AnUnwritableRunFolderIsAnErrorNotACrash) {
 }
 
 }  // namespace
+
+// set_pose on RELOC_COMMAND: the relocaliser takes the operator's guess of where the robot is in the saved map
+// only as five (or four) finite numbers with a positive radius, and only when it has a map; anything else is
+// refused and counted.
+TEST(Commands, SetPoseIsTakenOnlyAsFiniteNumbersAndOnlyWithAMap) {
+  MapOwnerInRunFolder owner;
+  auto& [parent, run, node, sink] = owner;
+  for (int k = 0; k < 30; ++k) adit::test::deliver(*node, "ODOM_MAPPED", adit::test::mappedMessage(k), sink);
+  adit::test::deliver(*node, "MAPPER_COMMAND", command("save_bundle", "corridor"), sink);
+  ASSERT_EQ(counter(*node, "bundles_saved"), 1);
+
+  adit::Config config;
+  config.set("reloc.prior_map", (fs::path(run) / "corridor").string());
+  const auto reloc = adit::nodes::makeNode("relocaliser", config);
+  ASSERT_EQ(reloc->state(), "relocalising");
+  for (const char* good : {"12.5 0 0 90", "1 -2 0.5 -45 8"})
+    adit::test::deliver(*reloc, "RELOC_COMMAND", command("set_pose", good), sink);
+  EXPECT_EQ(counter(*reloc, "poses_set"), 2);
+  for (const char* bad : {"", "1 2 0", "1 2 0 nan", "1 2 0 90 -3", "1 2 0 90 0", "x y z h", "1 2 0 90 4 5", "1e999 0 0 0",
+                          "1 2 0 90deg"})
+    adit::test::deliver(*reloc, "RELOC_COMMAND", command("set_pose", bad), sink);
+  EXPECT_EQ(counter(*reloc, "command_refused"), 9);
+  adit::test::deliver(*reloc, "RELOC_COMMAND", command("save_map", ""), sink);
+  EXPECT_EQ(counter(*reloc, "unknown_command"), 1);
+  EXPECT_EQ(counter(*reloc, "poses_set"), 2);
+
+  const auto without_map = adit::nodes::makeNode("relocaliser", adit::Config{});
+  adit::test::deliver(*without_map, "RELOC_COMMAND", command("set_pose", "1 2 0 90"), sink);
+  EXPECT_EQ(counter(*without_map, "command_refused"), 1);
+  EXPECT_EQ(counter(*without_map, "poses_set"), 0);
+}

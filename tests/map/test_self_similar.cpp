@@ -113,11 +113,12 @@ struct Standing {
   std::optional<Eigen::Isometry3d> fix;
 };
 
-// A robot standing for 6 s at (x, y, heading), relocalising in the map.
-Standing standAt(bool irregular, double x, double y, double heading, bool refuse) {
+// A robot standing for 6 s at (x, y, heading), relocalising in the map (told it starts near `start`, if given).
+Standing standAt(bool irregular, double x, double y, double heading, bool refuse, const PoseHintConfig& start = {}) {
   LoopCloserConfig loop;
   RelocaliserConfig config = testConfig();
   config.refuse_self_similar = refuse;
+  config.start = start;
   Relocaliser reloc(mapOf(irregular, loop), loop, config);
   const Cloud cloud = view(irregular, x, y, heading);
   Standing run;
@@ -149,6 +150,28 @@ TEST(SelfSimilarMap, IrregularPillarsAreDistinctAndAStartInsideIsFixedWhereItIs)
                                    << run.stats.rejected_degenerate << " degenerate, " << run.stats.rejected_ambiguous
                                    << " ambiguous, " << run.stats.rejected_self_similar << " self-similar";
   EXPECT_LT((run.fix->translation() - pose2d(20.3, 0.2, 0.1).translation()).norm(), 0.3);
+}
+
+// In the regular grid every fix is refused (self-similar); told where it starts to within a few metres (the
+// operator's start pose, 0.8 m and 6 deg off here) the robot is fixed where it is: no twin is that close.
+// Told a place with no keyframe within its radius, it is not fixed at all.
+TEST(SelfSimilarMap, AGivenStartPoseIsFixedInARegularGridOnlyNearIt) {
+  PoseHintConfig start;
+  start.given = true;
+  start.x = 21.0, start.y = -0.3, start.z = 1.2, start.heading_deg = 12.0;
+  const Standing run = standAt(false, 20.3, 0.2, 0.1, true, start);
+  ASSERT_TRUE(run.fix.has_value()) << run.stats.queries << " queries, " << run.stats.hinted_queries << " near the start, "
+                                   << run.stats.rejected_fit << " bad fits, " << run.stats.rejected_degenerate
+                                   << " degenerate, " << run.stats.rejected_ambiguous << " ambiguous, "
+                                   << run.stats.rejected_far_from_hint << " far from it";
+  EXPECT_LT((run.fix->translation() - pose2d(20.3, 0.2, 0.1).translation()).norm(), 0.3);
+  EXPECT_EQ(run.stats.rejected_self_similar, 0);
+  EXPECT_GT(run.stats.hinted_queries, 0);
+
+  start.x = 80.0;  // 32 m beyond the mapped 0-48 m
+  const Standing outside = standAt(false, 20.3, 0.2, 0.1, true, start);
+  EXPECT_FALSE(outside.fix.has_value());
+  EXPECT_GT(outside.stats.hinted_queries, 0);
 }
 
 }  // namespace
