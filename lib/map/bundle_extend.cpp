@@ -23,7 +23,8 @@ const ConfigTable<BundleExtendConfig>& bundleExtendConfigTable() {
      .add("max_anchor_gap_s", &E::max_anchor_gap_s, above(0), "s", "extend: a measured pose in the map ties the keyframe nearest it in time when within this")
      .add("anchor_sigma_m", &E::anchor_sigma_m, above(0), "m", "extend: standard deviation of a measured pose in the map (translation)")
      .add("anchor_sigma_deg", &E::anchor_sigma_deg, above(0), "deg", "extend: standard deviation of a measured pose in the map (rotation)")
-     .add("map_clearance_voxels", &E::map_clearance_voxels, between(0, 10), "voxels", "extend: a new map point is added only where no saved point lies within this many voxels");
+     .add("map_clearance_voxels", &E::map_clearance_voxels, between(0, 10), "voxels", "extend: a new map point is added only where no saved point lies within this many voxels")
+     .add("hold_saved_map", &E::hold_saved_map, anyValue(), "", "extend: keep the saved map's keyframes and points where they are (else the graph of both runs is solved whole and the saved map redrawn)");
     return t;
   }();
   return table;
@@ -51,14 +52,20 @@ int nearestKeyframeInTime(const std::vector<BundleKeyframe>& keyframes, std::int
   return best;
 }
 
-// Index of the saved keyframe nearest `position` and its distance.
-std::pair<int, double> nearestKeyframe(const std::vector<BundleKeyframe>& keyframes, const Eigen::Vector3d& position) {
+// Index of the position nearest `position` and its distance.
+std::pair<int, double> nearest(const std::vector<Eigen::Vector3d>& positions, const Eigen::Vector3d& position) {
   std::pair<int, double> best{-1, std::numeric_limits<double>::infinity()};
-  for (std::size_t k = 0; k < keyframes.size(); ++k) {
-    const double d = (keyframes[k].pose.translation() - position).norm();
+  for (std::size_t k = 0; k < positions.size(); ++k) {
+    const double d = (positions[k] - position).norm();
     if (d < best.second) best = {static_cast<int>(k), d};
   }
   return best;
+}
+
+std::vector<Eigen::Vector3d> positionsOf(const std::vector<BundleKeyframe>& keyframes) {
+  std::vector<Eigen::Vector3d> out;
+  for (const BundleKeyframe& k : keyframes) out.push_back(k.pose.translation());
+  return out;
 }
 
 Matrix6d anchorInformation(const BundleExtendConfig& c) {
@@ -157,29 +164,36 @@ MapBundle extendBundle(const MapBundle& prior, const MapBundle& session, const T
   }
   const Matrix6d information = anchorInformation(config);
   std::vector<PoseGraphEdge> anchor_edges;
+  const std::vector<Eigen::Vector3d> measured_positions = positionsOf(prior.keyframes);  // where the anchors were measured
   for (const auto& [k, T_map_kf] : anchored) {
-    const int j = nearestKeyframe(prior.keyframes, T_map_kf.translation()).first;
+    const int j = nearest(measured_positions, T_map_kf.translation()).first;
     anchor_edges.push_back({j, N + k, prior.keyframes[static_cast<std::size_t>(j)].pose.inverse() * T_map_kf, information, true});
     graph.addEdge(anchor_edges.back());
   }
   PoseGraphConfig solve;
-  solve.fixed_nodes = N;
+  solve.fixed_nodes = config.hold_saved_map ? N : 1;
   solve.max_iterations = 100;
   report.solved = graph.optimize(solve).solved;
   if (!report.solved) throw BundleError("the pose graph joining the new session to the saved map did not solve");
 
-  // Keyframes where the session drove through mapped roadway are dropped; the rest join the bundle.
+  // The saved keyframes where the solution puts them; then the session's, except where it drove through mapped
+  // roadway.
   MapBundle out;
   out.keyframes = prior.keyframes;
-  for (int i = 0; i < N; ++i) out.graph.addNode(prior.graph.pose(i));
+  for (int i = 0; i < N; ++i) {
+    BundleKeyframe& k = out.keyframes[static_cast<std::size_t>(i)];
+    report.saved_moved_max_m = std::max(report.saved_moved_max_m, (graph.pose(i).translation() - k.pose.translation()).norm());
+    k.pose = graph.pose(i);
+    out.graph.addNode(k.pose);
+  }
   for (const PoseGraphEdge& e : prior.graph.edges()) out.graph.addEdge(e);
   std::vector<int> id(static_cast<std::size_t>(M), -1);
-  std::vector<Eigen::Vector3d> session_positions, prior_positions;
-  for (const BundleKeyframe& k : prior.keyframes) prior_positions.push_back(k.pose.translation());
+  std::vector<Eigen::Vector3d> session_positions;
+  const std::vector<Eigen::Vector3d> saved_positions = positionsOf(out.keyframes);  // solved
   for (int i = 0; i < M; ++i) {
     const Eigen::Isometry3d& pose = graph.pose(N + i);
     session_positions.push_back(pose.translation());
-    if (nearestKeyframe(prior.keyframes, pose.translation()).second < config.overlap_radius) {
+    if (nearest(saved_positions, pose.translation()).second < config.overlap_radius) {
       ++report.overlap_keyframes;
       continue;
     }
@@ -205,9 +219,8 @@ MapBundle extendBundle(const MapBundle& prior, const MapBundle& session, const T
   for (int i = 0; i < M; ++i) {
     if (!kept(i) || ((i == 0 || kept(i - 1)) && (i == M - 1 || kept(i + 1)))) continue;
     const Eigen::Isometry3d& pose = graph.pose(N + i);
-    const int j = nearestKeyframe(prior.keyframes, pose.translation()).first;
-    out.graph.addOdometryEdge(j, id[static_cast<std::size_t>(i)], prior.keyframes[static_cast<std::size_t>(j)].pose.inverse() * pose,
-                              information);
+    const int j = nearest(saved_positions, pose.translation()).first;
+    out.graph.addOdometryEdge(j, id[static_cast<std::size_t>(i)], graph.pose(j).inverse() * pose, information);
     ++report.junction_edges;
   }
 
@@ -217,9 +230,20 @@ MapBundle extendBundle(const MapBundle& prior, const MapBundle& session, const T
   std::optional<VoxelAccumulator> grid;  // map_voxel 0: the points as they are
   if (voxel > 0) grid.emplace(voxel);
   const auto add = [&](const Eigen::Vector3f& p) { grid ? grid->add(p) : out.map.push_back(p); };
-  for (const Eigen::Vector3f& p : prior.map) {
+  const auto addSaved = [&](const Eigen::Vector3f& p) {
     occupied.add(p);
     add(p);
+  };
+  if (config.hold_saved_map) {
+    for (const Eigen::Vector3f& p : prior.map) addSaved(p);
+  } else {
+    // Redrawn as the loop closer draws its map: keyframe by keyframe, a revisit's (empty) cloud skipped.
+    for (int i = 0; i < N; ++i) {
+      const BundleKeyframe& k = out.keyframes[static_cast<std::size_t>(i)];
+      const Eigen::Isometry3f T = k.pose.cast<float>();
+      for (const Eigen::Vector3f& p : k.cloud.decode())
+        if (const Eigen::Vector3f w = T * p; w.allFinite()) addSaved(w);
+    }
   }
   for (int i = 0; i < M; ++i) {
     if (!kept(i)) continue;
@@ -233,7 +257,7 @@ MapBundle extendBundle(const MapBundle& prior, const MapBundle& session, const T
   }
   if (grid) out.map = grid->centroids();
   out.config = session.config;
-  report.added_roadway_m = roadwayLength(session_positions, 3.0, 30, prior_positions);
+  report.added_roadway_m = roadwayLength(session_positions, 3.0, 30, saved_positions);
   out.summary = bundleSummaryOf(out.keyframes, voxel, out.config, prior.summary.roadway_length_m + report.added_roadway_m);
   if (report_out) *report_out = report;
   return out;

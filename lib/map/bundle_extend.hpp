@@ -4,10 +4,14 @@
 // What ties the session to the map are its anchors: the sweeps whose pose in the map frame the relocaliser
 // measured (the fix, and every verified tracking fit), not carried by odometry. Each anchor becomes an edge
 // from the nearest saved keyframe to the session keyframe nearest it in time; the session's own pose graph
-// (odometry and its loops) joins its keyframes; the saved map's nodes are held fixed and the session's are
-// optimised. Where the session drove through mapped roadway its keyframes are dropped (the map already holds
-// that roadway: no second copy of it, no ghost walls); the rest are added, with their clouds added to the
-// map only where the saved map has no point nearby.
+// (odometry and its loops) joins its keyframes; with the saved graph this is one pose graph of both sessions.
+// By default it is solved whole (only the map's first keyframe, its frame, held): a session that leaves the
+// map and comes back into it elsewhere closes a loop through both, which corrects the saved map's own drift
+// too, and the saved map is redrawn from its keyframes' clouds at their new poses. With hold_saved_map the
+// saved keyframes and points stay exactly where they were (coordinates marked in the old map stay valid) and
+// only the session's keyframes move. Where the session drove through mapped roadway its keyframes are dropped
+// (the map already holds that roadway: no second copy of it, no ghost walls); the rest are added, with their
+// clouds added to the map only where the saved map has no point nearby.
 #pragma once
 
 #include "core/config_table.hpp"
@@ -29,6 +33,9 @@ struct BundleExtendConfig {
   double anchor_sigma_deg = 0.5;
   // A new point is added to the map only when no saved map point lies within this many voxels of it.
   int map_clearance_voxels = 1;
+  // Keep the saved map's keyframes and points where they are (only the session moves); else the graph of both
+  // sessions is solved whole and the saved map redrawn.
+  bool hold_saved_map = false;
 };
 
 const ConfigTable<BundleExtendConfig>& bundleExtendConfigTable();
@@ -40,6 +47,7 @@ struct BundleExtendReport {
   int kept_keyframes = 0;      // added to the bundle
   int overlap_keyframes = 0;   // dropped: roadway the map already held
   int junction_edges = 0;      // edges joining a kept stretch to the saved map where its neighbour was dropped
+  double saved_moved_max_m = 0.0;  // largest move of a saved keyframe (0 with hold_saved_map)
   std::size_t map_points_added = 0;
   double added_roadway_m = 0.0;
   bool solved = false;

@@ -42,7 +42,8 @@ class LoopCloserNode : public runtime::Node, public WritesProducts, public Write
     subscribe<adit::odometry_t>("mapped", "ODOM_MAPPED", [this](const adit::odometry_t& m) { onMapped(m); });
     // Extending a saved map: the relocaliser's measured poses in it are what join this run's map to it.
     if (reloc_.extending())
-      subscribe<adit::odometry_t>("pose_in_map", "POSE_IN_MAP", [this](const adit::odometry_t& m) { onPoseInMap(m); });
+      subscribe<adit::odometry_t>("pose_in_map", "POSE_IN_MAP", [this](const adit::odometry_t& m) { onPoseInMap(m); },
+                                  runtime::InputKind::Events);  // none while relocalising: gaps are normal
     subscribe<adit::command_t>("command", "MAPPER_COMMAND", [this](const adit::command_t& m) { onCommand(m); },
                                runtime::InputKind::Requests);
     advertise("loop", "LOOP_CLOSURE");
@@ -68,8 +69,9 @@ class LoopCloserNode : public runtime::Node, public WritesProducts, public Write
       setCount("extend_keyframes_added", r.kept_keyframes);
       setCount("extend_keyframes_overlap", r.overlap_keyframes);
       spdlog::info("[loop_closer] extended {}: {} of {} keyframes added ({} on mapped roadway), {} anchors used, "
-                   "{} map points and {:.0f} m of roadway added", reloc_.prior_map, r.kept_keyframes,
-                   r.session_keyframes, r.overlap_keyframes, r.anchors_used, r.map_points_added, r.added_roadway_m);
+                   "{} map points and {:.0f} m of roadway added; saved keyframes moved up to {:.2f} m", reloc_.prior_map,
+                   r.kept_keyframes, r.session_keyframes, r.overlap_keyframes, r.anchors_used, r.map_points_added,
+                   r.added_roadway_m, r.saved_moved_max_m);
       return both;
     } catch (const BundleError& e) {
       throw std::runtime_error("cannot extend " + reloc_.prior_map + ": " + e.what());

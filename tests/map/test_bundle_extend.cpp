@@ -102,6 +102,7 @@ TEST(BundleExtend, NewRoadwayJoinsTheMapAtItsTruePlaceAndMappedRoadwayIsKeptOnce
   BundleExtendReport report;
   BundleExtendConfig config;
   config.overlap_radius = 2.5;  // keyframes 1 m apart: 52 m is 2 m from the saved 50 m, 53 m is 3 m from it
+  config.hold_saved_map = true;
   const MapBundle both = extendBundle(s.prior, s.session, s.session_poses, s.anchors, config, &report);
   EXPECT_TRUE(report.solved);
   EXPECT_EQ(report.anchors_used, 16);
@@ -145,6 +146,25 @@ TEST(BundleExtend, NewRoadwayJoinsTheMapAtItsTruePlaceAndMappedRoadwayIsKeptOnce
   EXPECT_EQ(loaded.graph.size(), 79);
   EXPECT_EQ(loadBundleMap(dir.string()).size(), both.map.size());
   fs::remove_all(dir);
+
+  // Solved whole (the default): the maps agree, so the saved keyframes barely move (the anchors' 2 cm noise
+  // against the saved graph's 1 cm edges) and the new roadway lands where it did.
+  config.hold_saved_map = false;
+  BundleExtendReport whole;
+  const MapBundle solved = extendBundle(s.prior, s.session, s.session_poses, s.anchors, config, &whole);
+  EXPECT_LT(whole.saved_moved_max_m, 0.03);
+  ASSERT_EQ(solved.keyframes.size(), both.keyframes.size());
+  for (std::size_t k = 51; k < solved.keyframes.size(); ++k)
+    EXPECT_LT(translationNorm(along(53.0 + static_cast<double>(k - 51)).inverse() * solved.keyframes[k].pose), 0.1);
+  // Redrawn from the keyframes' clouds at their solved poses: every point on a surface the saved map had.
+  std::size_t off_surface = 0;
+  for (const Eigen::Vector3f& p : solved.map) {
+    if (p.x() >= 59.5f) continue;
+    bool near = false;
+    for (const Eigen::Vector3f& q : s.prior.map) near = near || (p - q).squaredNorm() < 0.15f * 0.15f;
+    off_surface += near ? 0 : 1;
+  }
+  EXPECT_EQ(off_surface, 0u);
 }
 
 TEST(BundleExtend, ASessionNeverMeasuredAgainstTheMapOrOfAnotherSensorIsRefused) {
