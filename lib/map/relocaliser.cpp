@@ -25,6 +25,8 @@ const ConfigTable<RelocaliserConfig>& relocaliserConfigTable() {
      .add("submap_radius", &R::submap_radius, atLeast(0), "m", "bundle keyframes within this of a candidate also in its submap")
      .add("query_distance", &R::query_distance, above(0), "m", "driving between two queries while relocalising")
      .add("query_interval_s", &R::query_interval_s, above(0), "s", "or this much sensor time between queries")
+     .add("query_backoff_after", &R::query_backoff_after, between(0, 100000), "queries", "queries in a row without a candidate fix after which their spacing doubles (again after as many more; 0 = never)")
+     .add("query_backoff_max", &R::query_backoff_max, between(1, 1000), "", "largest factor the spacing of queries grows to")
      .add("ambiguity_distance", &R::ambiguity_distance, above(0), "m", "fits farther apart than this are different places")
      .add("ambiguity_margin", &R::ambiguity_margin, between(0, 1), "", "a fit elsewhere with an inlier ratio within this of the best makes the query ambiguous")
      .add("min_consistent_fixes", &R::min_consistent_fixes, between(1, 100), "", "verified unambiguous queries that must agree before a fix")
@@ -112,6 +114,7 @@ Relocaliser::Result Relocaliser::process(const PoseEstimate& session, const std:
                  std::numeric_limits<int>::max()};
     next_hint_.reset();
     pending_.clear();
+    fruitless_queries_ = 0;  // a new place to look at: at full pace
   }
   if (stalled || registration_failed) recent_.clear();  // the session's motion across the gap is not trusted
   recent_.emplace_back(session.pose, cloud);
@@ -146,8 +149,11 @@ void Relocaliser::loseFix() {
 void Relocaliser::relocalise(const PoseEstimate& session, Result& result) {
   // Not found near it within its distance or queries (standing still): the whole map again.
   if (hint_ && (travelled_ > hint_->until_travelled || hint_->queries_left <= 0)) hint_.reset();
-  const bool due = travelled_ - last_query_travelled_ >= config_.query_distance ||
-                   static_cast<double>(session.utime - last_query_utime_) * 1e-6 >= config_.query_interval_s;
+  const double spacing = config_.query_backoff_after > 0
+                             ? std::min(config_.query_backoff_max, std::pow(2.0, fruitless_queries_ / config_.query_backoff_after))
+                             : 1.0;
+  const bool due = travelled_ - last_query_travelled_ >= config_.query_distance * spacing ||
+                   static_cast<double>(session.utime - last_query_utime_) * 1e-6 >= config_.query_interval_s * spacing;
   if (!due) return;
   last_query_travelled_ = travelled_;
   last_query_utime_ = session.utime;
@@ -155,6 +161,7 @@ void Relocaliser::relocalise(const PoseEstimate& session, Result& result) {
   pending_.erase(std::remove_if(pending_.begin(), pending_.end(),
                                 [&](const Fix& p) { return travelled_ - p.travelled > config_.consistency_window_m; }),
                  pending_.end());
+  fruitless_queries_ = fix ? 0 : fruitless_queries_ + 1;
   if (!fix) return;
   int agreeing = 1;
   bool any_disagree = false;
@@ -173,6 +180,7 @@ void Relocaliser::relocalise(const PoseEstimate& session, Result& result) {
   pending_.clear();
   hint_.reset();
   track_failures_ = 0;
+  fruitless_queries_ = 0;
   ++stats_.fixes;
   result.fixed_now = true;
   result.anchored_now = true;

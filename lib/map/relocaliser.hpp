@@ -56,6 +56,11 @@ struct RelocaliserConfig {
   double submap_radius = 20.0;   // m: ... and keyframes of other passes this close to the candidate
   double query_distance = 0.5;   // m driven between two queries while relocalising
   double query_interval_s = 1.0; // ... or this much sensor time
+  // After this many queries in a row without a fit worth keeping (a run outside the map: new roadway being
+  // extended, or a place the map cannot tell), the spacing doubles, and again after as many more, up to
+  // query_backoff_max times: a query costs ~1 s of CPU, which a live run cannot spend every 0.5 m for long.
+  int query_backoff_after = 10;  // 0 = never
+  double query_backoff_max = 8.0;
   double ambiguity_distance = 3.0;  // m: two fits farther apart than this are different places
   double ambiguity_margin = 0.15;   // a fit elsewhere with an inlier ratio within this of the best: ambiguous
   int min_consistent_fixes = 2;     // verified, unambiguous queries that must agree before the first fix
@@ -213,6 +218,7 @@ class Relocaliser {
   std::int64_t last_utime_ = 0;
   double travelled_ = 0.0;
   double last_query_travelled_ = -1e9;
+  int fruitless_queries_ = 0;  // queries in a row that gave no candidate fix (spacing backs off)
   std::int64_t last_query_utime_ = 0;
   int track_failures_ = 0;
   std::deque<std::pair<Eigen::Isometry3d, std::vector<Eigen::Vector3f>>> recent_;  // newest query_sweeps sweeps
