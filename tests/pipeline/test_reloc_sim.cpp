@@ -113,7 +113,11 @@ TEST(RelocaliseSim, ASecondDriveExtendsTheMapWithItsNewRoadwayOnly) {
   const MapBundle both = loadMapBundle(joined);
   const std::size_t n = a.keyframes.size();
   ASSERT_GT(both.keyframes.size(), n + 30) << "the new roadway (~55 m) was not added";
-  for (std::size_t k = 0; k < n; ++k) ASSERT_TRUE(both.keyframes[k].pose.isApprox(a.keyframes[k].pose, 1e-9));
+  // Solved whole, but this run closes no loop through the map: the saved keyframes stay where they were.
+  double saved_moved = 0;
+  for (std::size_t k = 0; k < n; ++k)
+    saved_moved = std::max(saved_moved, (both.keyframes[k].pose.translation() - a.keyframes[k].pose.translation()).norm());
+  EXPECT_LT(saved_moved, 0.05);
 
   const Eigen::Isometry3d T_world_map = first.ground_truth.front().pose * first.estimate.front().pose.inverse();
   std::map<std::int64_t, Eigen::Isometry3d> truth;
@@ -145,9 +149,10 @@ TEST(RelocaliseSim, ASecondDriveExtendsTheMapWithItsNewRoadwayOnly) {
   std::printf("extended: %zu + %zu keyframes; new ones: APE RMSE %.3f m, worst %.3f m / %.2f deg, nearest to the first "
               "drive's path %.2f m; roadway %.1f m (%.1f + new), truth %.1f m\n", n, both.keyframes.size() - n, rmse,
               worst, worst_deg, nearest_first, both.summary.roadway_length_m, a.summary.roadway_length_m, true_union);
-  // Measured (2026-11-28): 49 of 91 keyframes added, RMSE 0.196 m, worst 0.258 m / 0.65 deg. The new roadway
-  // starts where the map is (0.148 m from the truth where the map itself is 0.155 m off at its end: the first
-  // drive's own drift over 75 m) and drifts 0.11 m more over 52 m of odometry with nothing to close on.
+  // Measured (2026-11-28): 49 of 91 keyframes added, RMSE 0.202 m, worst 0.265 m / 0.83 deg, saved keyframes
+  // moved <= 0.01 m. The new roadway starts where the map is (0.153 m from the truth where the map itself is
+  // 0.155 m off at its end: the first drive's own drift over 75 m) and drifts 0.11 m more over 52 m of odometry
+  // with nothing to close on.
   EXPECT_LE(std::abs(errors.front() - map_end_error), 0.1) << "the new roadway does not continue the map";
   EXPECT_LE(worst - map_end_error, 0.25);
   EXPECT_LE(rmse, 0.3);
@@ -167,7 +172,7 @@ TEST(RelocaliseSim, ASecondDriveExtendsTheMapWithItsNewRoadwayOnly) {
     third_worst = std::max(third_worst, translationNorm(third_truth[p.utime].inverse() * T_world_map * p.pose));
   std::printf("third drive: first fix after %.1f s, worst %.3f m\n",
               static_cast<double>(third.in_map.front().utime - third.ground_truth.front().utime) * 1e-6, third_worst);
-  // Measured: first fix after 7.0 s, worst 0.268 m (the joined map's own error there, see above).
+  // Measured: first fix after 7.0 s, worst 0.274 m (the joined map's own error there, see above).
   EXPECT_LE(third_worst, 0.4);
   for (const std::string& dir : {first.out_dir, second.out_dir, third.out_dir, first_bundle, joined}) fs::remove_all(dir);
 }
