@@ -174,5 +174,30 @@ TEST(SelfSimilarMap, AGivenStartPoseIsFixedInARegularGridOnlyNearIt) {
   EXPECT_GT(outside.stats.hinted_queries, 0);
 }
 
+// Queries that find nothing (here: told a start outside the map, so no keyframe to verify) come less often:
+// after every query_backoff_after of them the spacing doubles, up to query_backoff_max.
+TEST(SelfSimilarMap, QueriesThatFindNothingBackOff) {
+  const LoopCloserConfig loop;
+  const Cloud cloud = view(true, 20.3, 0.2, 0.1);
+  const auto queriesIn = [&](int backoff_after, double seconds) {
+    RelocaliserConfig config = testConfig();
+    config.refuse_self_similar = false;
+    config.start.given = true;
+    config.start.x = 80.0;
+    config.query_backoff_after = backoff_after;
+    config.query_backoff_max = 4.0;
+    Relocaliser reloc(mapOf(true, loop), loop, config);
+    for (int i = 0; i <= static_cast<int>(seconds * 10); ++i) {
+      PoseEstimate session;
+      session.utime = 100000000LL + i * 100000LL;
+      reloc.process(session, cloud, false);
+    }
+    return reloc.stats().queries;
+  };
+  // Standing still, one query a second: 0, 1, then every 2 s (3, 5), then every 4 s (9, 13, 17) over 20 s.
+  EXPECT_EQ(queriesIn(0, 20.0), 21);
+  EXPECT_EQ(queriesIn(2, 20.0), 7);
+}
+
 }  // namespace
 }  // namespace adit
