@@ -124,6 +124,130 @@ std::map<int, Eigen::Isometry3d> anchoredKeyframes(const MapBundle& session, con
   return out;
 }
 
+// The pose graph of both runs, solved: the saved map's nodes 0..N-1 (held only with hold_saved_map; else only
+// node 0, the map's frame), then the session's, started from the offset to the map of the anchor nearest in time,
+// joined by the session's own edges and one edge per anchor from the nearest saved keyframe.
+struct JointGraph {
+  PoseGraph graph;
+  std::vector<PoseGraphEdge> anchor_edges;
+};
+
+JointGraph solveJointGraph(const MapBundle& prior, const MapBundle& session, const std::map<int, Eigen::Isometry3d>& anchored,
+                           const BundleExtendConfig& config, BundleExtendReport& report) {
+  const int N = static_cast<int>(prior.keyframes.size());
+  JointGraph joint{prior.graph, {}};
+  std::vector<std::pair<std::int64_t, Eigen::Isometry3d>> offsets;  // T_map_session at anchored keyframes
+  for (const auto& [k, T_map_kf] : anchored)
+    offsets.emplace_back(session.keyframes[static_cast<std::size_t>(k)].utime,
+                         T_map_kf * session.keyframes[static_cast<std::size_t>(k)].pose.inverse());
+  for (const BundleKeyframe& k : session.keyframes) {
+    const auto nearest = std::min_element(offsets.begin(), offsets.end(), [&](const auto& a, const auto& b) {
+      return std::llabs(a.first - k.utime) < std::llabs(b.first - k.utime);
+    });
+    joint.graph.addNode(nearest->second * k.pose);
+  }
+  for (PoseGraphEdge e : session.graph.edges()) {
+    e.from += N;
+    e.to += N;
+    joint.graph.addEdge(e);
+  }
+  const std::vector<Eigen::Vector3d> measured_against = positionsOf(prior.keyframes);
+  for (const auto& [k, T_map_kf] : anchored) {
+    const int j = nearest(measured_against, T_map_kf.translation()).first;
+    joint.anchor_edges.push_back({j, N + k, prior.keyframes[static_cast<std::size_t>(j)].pose.inverse() * T_map_kf,
+                                  anchorInformation(config), true});
+    joint.graph.addEdge(joint.anchor_edges.back());
+  }
+  PoseGraphConfig solve;
+  solve.fixed_nodes = config.hold_saved_map ? N : 1;
+  solve.max_iterations = 100;
+  report.solved = joint.graph.optimize(solve).solved;
+  if (!report.solved) throw BundleError("the pose graph joining the new session to the saved map did not solve");
+  return joint;
+}
+
+// The saved keyframes at their solved poses, then the session's except those on mapped roadway (within
+// overlap_radius of a saved one), into `out` with their graph: the saved edges, the session's and the anchors'
+// between kept nodes, and where a kept stretch's neighbour was dropped an edge to the nearest saved keyframe at
+// the solved relative pose (the graph stays connected). Returns each session keyframe's node in `out` (-1: dropped).
+std::vector<int> joinKeyframes(const MapBundle& prior, const MapBundle& session, const JointGraph& joint,
+                               const BundleExtendConfig& config, MapBundle& out, BundleExtendReport& report) {
+  const int N = static_cast<int>(prior.keyframes.size()), M = static_cast<int>(session.keyframes.size());
+  out.keyframes = prior.keyframes;
+  for (int i = 0; i < N; ++i) {
+    BundleKeyframe& k = out.keyframes[static_cast<std::size_t>(i)];
+    report.saved_moved_max_m = std::max(report.saved_moved_max_m, (joint.graph.pose(i).translation() - k.pose.translation()).norm());
+    k.pose = joint.graph.pose(i);
+    out.graph.addNode(k.pose);
+  }
+  for (const PoseGraphEdge& e : prior.graph.edges()) out.graph.addEdge(e);
+  const std::vector<Eigen::Vector3d> saved = positionsOf(out.keyframes);
+  std::vector<int> id(static_cast<std::size_t>(M), -1);
+  for (int i = 0; i < M; ++i) {
+    const Eigen::Isometry3d& pose = joint.graph.pose(N + i);
+    if (nearest(saved, pose.translation()).second < config.overlap_radius) {
+      ++report.overlap_keyframes;
+      continue;
+    }
+    const BundleKeyframe& k = session.keyframes[static_cast<std::size_t>(i)];
+    id[static_cast<std::size_t>(i)] = out.graph.addNode(pose);
+    out.keyframes.push_back({k.utime, pose, k.cloud, k.context});
+  }
+  report.kept_keyframes = M - report.overlap_keyframes;
+  const auto kept = [&](int i) { return i >= 0 && i < M && id[static_cast<std::size_t>(i)] >= 0; };
+  for (PoseGraphEdge e : session.graph.edges()) {
+    if (!kept(e.from) || !kept(e.to)) continue;
+    e.from = id[static_cast<std::size_t>(e.from)];
+    e.to = id[static_cast<std::size_t>(e.to)];
+    out.graph.addEdge(e);
+  }
+  for (PoseGraphEdge e : joint.anchor_edges) {
+    if (!kept(e.to - N)) continue;
+    e.to = id[static_cast<std::size_t>(e.to - N)];
+    out.graph.addEdge(e);
+  }
+  for (int i = 0; i < M; ++i) {
+    if (!kept(i) || ((i == 0 || kept(i - 1)) && (i == M - 1 || kept(i + 1)))) continue;
+    const Eigen::Isometry3d& pose = joint.graph.pose(N + i);
+    const int j = nearest(saved, pose.translation()).first;
+    out.graph.addOdometryEdge(j, id[static_cast<std::size_t>(i)], joint.graph.pose(j).inverse() * pose, anchorInformation(config));
+    ++report.junction_edges;
+  }
+  return id;
+}
+
+// The saved map (as it was with hold_saved_map, else redrawn from the saved keyframes at their solved poses the
+// way the loop closer draws a map), and the kept session keyframes' points where it has none nearby.
+std::vector<Eigen::Vector3f> joinedMap(const MapBundle& prior, const MapBundle& out, const MapBundle& session,
+                                       const PoseGraph& solved, const std::vector<int>& id,
+                                       const BundleExtendConfig& config, BundleExtendReport& report) {
+  const double voxel = prior.summary.map_voxel;
+  const int N = static_cast<int>(prior.keyframes.size());
+  Occupancy occupied(voxel > 0 ? voxel : 0.1);
+  std::vector<Eigen::Vector3f> points;
+  std::optional<VoxelAccumulator> grid;  // map_voxel 0: the points as they are
+  if (voxel > 0) grid.emplace(voxel);
+  const auto add = [&](const Eigen::Vector3f& p) { grid ? grid->add(p) : points.push_back(p); };
+  const auto addCloud = [&](const BundleKeyframe& k, const Eigen::Isometry3d& pose, bool saved) {
+    const Eigen::Isometry3f T = pose.cast<float>();
+    for (const Eigen::Vector3f& p : k.cloud.decode()) {
+      const Eigen::Vector3f w = T * p;
+      if (!w.allFinite() || (!saved && occupied.near(w, config.map_clearance_voxels))) continue;
+      if (saved) occupied.add(w);
+      else ++report.map_points_added;
+      add(w);
+    }
+  };
+  if (config.hold_saved_map) {
+    for (const Eigen::Vector3f& p : prior.map) occupied.add(p), add(p);
+  } else {
+    for (int i = 0; i < N; ++i) addCloud(out.keyframes[static_cast<std::size_t>(i)], out.keyframes[static_cast<std::size_t>(i)].pose, true);
+  }
+  for (std::size_t i = 0; i < id.size(); ++i)
+    if (id[i] >= 0) addCloud(session.keyframes[i], solved.pose(N + static_cast<int>(i)), false);
+  return grid ? grid->centroids() : points;
+}
+
 }  // namespace
 
 MapBundle extendBundle(const MapBundle& prior, const MapBundle& session, const Trajectory& session_poses,
@@ -144,121 +268,18 @@ MapBundle extendBundle(const MapBundle& prior, const MapBundle& session, const T
                                   "{} s of a keyframe): nothing ties it to the map",
                                   anchors.size(), config.max_anchor_gap_s));
 
-  // The joint graph: the saved map's nodes (fixed), then the session's, started from the offset to the map of
-  // the anchor nearest in time.
-  PoseGraph graph = prior.graph;
-  std::vector<std::pair<std::int64_t, Eigen::Isometry3d>> offsets;  // T_map_session at anchored keyframes
-  for (const auto& [k, T_map_kf] : anchored)
-    offsets.emplace_back(session.keyframes[static_cast<std::size_t>(k)].utime,
-                         T_map_kf * session.keyframes[static_cast<std::size_t>(k)].pose.inverse());
-  for (const BundleKeyframe& k : session.keyframes) {
-    const auto nearest = std::min_element(offsets.begin(), offsets.end(), [&](const auto& a, const auto& b) {
-      return std::llabs(a.first - k.utime) < std::llabs(b.first - k.utime);
-    });
-    graph.addNode(nearest->second * k.pose);
-  }
-  for (PoseGraphEdge e : session.graph.edges()) {
-    e.from += N;
-    e.to += N;
-    graph.addEdge(e);
-  }
-  const Matrix6d information = anchorInformation(config);
-  std::vector<PoseGraphEdge> anchor_edges;
-  const std::vector<Eigen::Vector3d> measured_positions = positionsOf(prior.keyframes);  // where the anchors were measured
-  for (const auto& [k, T_map_kf] : anchored) {
-    const int j = nearest(measured_positions, T_map_kf.translation()).first;
-    anchor_edges.push_back({j, N + k, prior.keyframes[static_cast<std::size_t>(j)].pose.inverse() * T_map_kf, information, true});
-    graph.addEdge(anchor_edges.back());
-  }
-  PoseGraphConfig solve;
-  solve.fixed_nodes = config.hold_saved_map ? N : 1;
-  solve.max_iterations = 100;
-  report.solved = graph.optimize(solve).solved;
-  if (!report.solved) throw BundleError("the pose graph joining the new session to the saved map did not solve");
-
-  // The saved keyframes where the solution puts them; then the session's, except where it drove through mapped
-  // roadway.
+  const JointGraph joint = solveJointGraph(prior, session, anchored, config, report);
   MapBundle out;
-  out.keyframes = prior.keyframes;
-  for (int i = 0; i < N; ++i) {
-    BundleKeyframe& k = out.keyframes[static_cast<std::size_t>(i)];
-    report.saved_moved_max_m = std::max(report.saved_moved_max_m, (graph.pose(i).translation() - k.pose.translation()).norm());
-    k.pose = graph.pose(i);
-    out.graph.addNode(k.pose);
-  }
-  for (const PoseGraphEdge& e : prior.graph.edges()) out.graph.addEdge(e);
-  std::vector<int> id(static_cast<std::size_t>(M), -1);
-  std::vector<Eigen::Vector3d> session_positions;
-  const std::vector<Eigen::Vector3d> saved_positions = positionsOf(out.keyframes);  // solved
-  for (int i = 0; i < M; ++i) {
-    const Eigen::Isometry3d& pose = graph.pose(N + i);
-    session_positions.push_back(pose.translation());
-    if (nearest(saved_positions, pose.translation()).second < config.overlap_radius) {
-      ++report.overlap_keyframes;
-      continue;
-    }
-    const BundleKeyframe& k = session.keyframes[static_cast<std::size_t>(i)];
-    id[static_cast<std::size_t>(i)] = out.graph.addNode(pose);
-    out.keyframes.push_back({k.utime, pose, k.cloud, k.context});
-  }
-  report.kept_keyframes = M - report.overlap_keyframes;
-  const auto kept = [&](int i) { return i >= 0 && i < M && id[static_cast<std::size_t>(i)] >= 0; };
-  for (PoseGraphEdge e : session.graph.edges()) {
-    if (!kept(e.from) || !kept(e.to)) continue;
-    e.from = id[static_cast<std::size_t>(e.from)];
-    e.to = id[static_cast<std::size_t>(e.to)];
-    out.graph.addEdge(e);
-  }
-  for (PoseGraphEdge e : anchor_edges) {
-    if (!kept(e.to - N)) continue;
-    e.to = id[static_cast<std::size_t>(e.to - N)];
-    out.graph.addEdge(e);
-  }
-  // A kept stretch whose neighbour was dropped meets the saved map there: join it to the nearest saved keyframe
-  // at the solved relative pose, so the saved graph stays one connected graph.
-  for (int i = 0; i < M; ++i) {
-    if (!kept(i) || ((i == 0 || kept(i - 1)) && (i == M - 1 || kept(i + 1)))) continue;
-    const Eigen::Isometry3d& pose = graph.pose(N + i);
-    const int j = nearest(saved_positions, pose.translation()).first;
-    out.graph.addOdometryEdge(j, id[static_cast<std::size_t>(i)], graph.pose(j).inverse() * pose, information);
-    ++report.junction_edges;
-  }
-
-  // The map: every saved point, and the kept keyframes' points where the saved map has none nearby.
-  const double voxel = prior.summary.map_voxel;
-  Occupancy occupied(voxel > 0 ? voxel : 0.1);
-  std::optional<VoxelAccumulator> grid;  // map_voxel 0: the points as they are
-  if (voxel > 0) grid.emplace(voxel);
-  const auto add = [&](const Eigen::Vector3f& p) { grid ? grid->add(p) : out.map.push_back(p); };
-  const auto addSaved = [&](const Eigen::Vector3f& p) {
-    occupied.add(p);
-    add(p);
-  };
-  if (config.hold_saved_map) {
-    for (const Eigen::Vector3f& p : prior.map) addSaved(p);
-  } else {
-    // Redrawn as the loop closer draws its map: keyframe by keyframe, a revisit's (empty) cloud skipped.
-    for (int i = 0; i < N; ++i) {
-      const BundleKeyframe& k = out.keyframes[static_cast<std::size_t>(i)];
-      const Eigen::Isometry3f T = k.pose.cast<float>();
-      for (const Eigen::Vector3f& p : k.cloud.decode())
-        if (const Eigen::Vector3f w = T * p; w.allFinite()) addSaved(w);
-    }
-  }
-  for (int i = 0; i < M; ++i) {
-    if (!kept(i)) continue;
-    const Eigen::Isometry3f T = graph.pose(N + i).cast<float>();
-    for (const Eigen::Vector3f& p : session.keyframes[static_cast<std::size_t>(i)].cloud.decode()) {
-      const Eigen::Vector3f w = T * p;
-      if (!w.allFinite() || occupied.near(w, config.map_clearance_voxels)) continue;
-      add(w);
-      ++report.map_points_added;
-    }
-  }
-  if (grid) out.map = grid->centroids();
+  const std::vector<int> id = joinKeyframes(prior, session, joint, config, out, report);
+  out.map = joinedMap(prior, out, session, joint.graph, id, config, report);
   out.config = session.config;
-  report.added_roadway_m = roadwayLength(session_positions, 3.0, 30, saved_positions);
-  out.summary = bundleSummaryOf(out.keyframes, voxel, out.config, prior.summary.roadway_length_m + report.added_roadway_m);
+  std::vector<Eigen::Vector3d> session_positions;
+  for (int i = 0; i < M; ++i) session_positions.push_back(joint.graph.pose(N + i).translation());
+  std::vector<Eigen::Vector3d> saved = positionsOf(out.keyframes);
+  saved.resize(static_cast<std::size_t>(N));
+  report.added_roadway_m = roadwayLength(session_positions, 3.0, 30, saved);
+  out.summary = bundleSummaryOf(out.keyframes, prior.summary.map_voxel, out.config,
+                                prior.summary.roadway_length_m + report.added_roadway_m);
   if (report_out) *report_out = report;
   return out;
 }
