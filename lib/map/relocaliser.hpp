@@ -59,7 +59,7 @@ struct RelocaliserConfig {
   // After this many queries in a row without a fit worth keeping (a run outside the map: new roadway being
   // extended, or a place the map cannot tell), the spacing doubles, and again after as many more, up to
   // query_backoff_max times: a query costs ~1 s of CPU, which a live run cannot spend every 0.5 m for long.
-  int query_backoff_after = 10;  // 0 = never
+  int query_backoff_after = 20;  // 0 = never
   double query_backoff_max = 8.0;
   double ambiguity_distance = 3.0;  // m: two fits farther apart than this are different places
   double ambiguity_margin = 0.15;   // a fit elsewhere with an inlier ratio within this of the best: ambiguous
