@@ -1,11 +1,11 @@
 #include "map/bundle_extend.hpp"
 
 #include "loop/voxel_filter.hpp"
+#include "mapping/voxel_key.hpp"
 
 #include <fmt/format.h>
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <cstdlib>
 #include <limits>
@@ -80,29 +80,19 @@ Matrix6d anchorInformation(const BundleExtendConfig& c) {
 class Occupancy {
  public:
   explicit Occupancy(double cell) : cell_(cell) {}
-  void add(const Eigen::Vector3f& p) { cells_.insert(key(p)); }
+  void add(const Eigen::Vector3f& p) { cells_.insert(voxelOf(p, cell_)); }
   bool near(const Eigen::Vector3f& p, int clearance) const {
-    const Key k = key(p);
+    const VoxelKey k = voxelOf(p, cell_);
     for (int dx = -clearance; dx <= clearance; ++dx)
       for (int dy = -clearance; dy <= clearance; ++dy)
         for (int dz = -clearance; dz <= clearance; ++dz)
-          if (cells_.count({k[0] + dx, k[1] + dy, k[2] + dz})) return true;
+          if (cells_.count({k.x + dx, k.y + dy, k.z + dz})) return true;
     return false;
   }
 
  private:
-  using Key = std::array<long long, 3>;
-  struct Hash {
-    std::size_t operator()(const Key& k) const {
-      return static_cast<std::size_t>(k[0] * 73856093LL ^ k[1] * 19349663LL ^ k[2] * 83492791LL);
-    }
-  };
-  Key key(const Eigen::Vector3f& p) const {
-    return {static_cast<long long>(std::floor(p.x() / cell_)), static_cast<long long>(std::floor(p.y() / cell_)),
-            static_cast<long long>(std::floor(p.z() / cell_))};
-  }
   double cell_;
-  std::unordered_set<Key, Hash> cells_;  // looked up only: its order never reaches the result
+  std::unordered_set<VoxelKey, VoxelKeyHash> cells_;  // looked up only: its order never reaches the result
 };
 
 // Session keyframe -> its pose in the map frame, from the anchor nearest it in time (one per keyframe).

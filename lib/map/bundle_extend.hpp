@@ -53,11 +53,12 @@ struct BundleExtendReport {
   bool solved = false;
 };
 
-// The bundle of both sessions. `prior` is the saved bundle with its map points (loadBundleMap); `session` the
-// session's own bundle (bundleFrom of its loop closer: keyframes at corrected poses in the session's frame, its
-// graph); `session_poses` the session's corrected pose of every sweep in the same frame (trajectory.tum) and
-// `anchors` its measured poses in the map frame (map_anchors.tum). Throws BundleError when no anchor ties the
-// session to the map (it never relocalised) or the sessions' sensor keys differ.
+// The bundle of both sessions. `prior` is the saved bundle (its map points, loadBundleMap, are read only with
+// hold_saved_map); `session` the session's own bundle (bundleFrom of its loop closer: keyframes at corrected
+// poses in the session's frame, its graph); `session_poses` the session's corrected pose of every sweep in the
+// same frame (LoopCloser::correctedTrajectory) and `anchors` its measured poses in the map frame (POSE_IN_MAP
+// flagged FLAG_MAP_MEASURED). Throws BundleError when no anchor ties the session to the map (it never
+// relocalised) or the sessions' sensor keys differ.
 MapBundle extendBundle(const MapBundle& prior, const MapBundle& session, const Trajectory& session_poses,
                        const Trajectory& anchors, const BundleExtendConfig& config, BundleExtendReport* report = nullptr);
 

@@ -62,7 +62,7 @@ class LoopCloserNode : public runtime::Node, public WritesProducts, public Write
     MapBundle prior;
     try {
       prior = loadMapBundle(reloc_.prior_map);
-      prior.map = loadBundleMap(reloc_.prior_map);
+      if (reloc_.extend.hold_saved_map) prior.map = loadBundleMap(reloc_.prior_map);  // else redrawn from keyframes
       BundleExtendReport r;
       MapBundle both = extendBundle(prior, run, closer_.correctedTrajectory(uncorrected_), anchors_, reloc_.extend, &r);
       setCount("extend_anchors_used", r.anchors_used);
