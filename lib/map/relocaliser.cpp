@@ -79,12 +79,8 @@ Relocaliser::Relocaliser(MapBundle bundle, const LoopCloserConfig& loop, const R
     alias_database_.add(k.context, k.utime);
   }
   // The judgement reads only the bundle, the databases and the configuration, none of which change from here.
-  if (config_.start.given) {
-    Eigen::Isometry3d start = Eigen::Isometry3d::Identity();
-    start.translation() = Eigen::Vector3d(config_.start.x, config_.start.y, config_.start.z);
-    start.linear() = Eigen::AngleAxisd(config_.start.heading_deg * M_PI / 180.0, Eigen::Vector3d::UnitZ()).toRotationMatrix();
-    setPoseHint(start, config_.start.radius);
-  }
+  if (config_.start.given)
+    setPoseHint(poseFromHeading(Eigen::Vector3d(config_.start.x, config_.start.y, config_.start.z), config_.start.heading_deg));
   if (config_.refuse_self_similar) map_judgement_ = std::async(std::launch::async, [this] { return judgeMap(); });
 }
 
@@ -92,8 +88,15 @@ Relocaliser::~Relocaliser() {
   if (map_judgement_.valid()) map_judgement_.wait();
 }
 
-void Relocaliser::setPoseHint(const Eigen::Isometry3d& T_map_lidar, double radius) {
-  next_hint_ = std::make_pair(T_map_lidar, radius);
+Eigen::Isometry3d poseFromHeading(const Eigen::Vector3d& position, double heading_deg) {
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  pose.translation() = position;
+  pose.linear() = Eigen::AngleAxisd(heading_deg * M_PI / 180.0, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  return pose;
+}
+
+void Relocaliser::setPoseHint(const Eigen::Isometry3d& T_map_lidar, std::optional<double> radius) {
+  next_hint_ = std::make_pair(T_map_lidar, radius.value_or(config_.start.radius));
 }
 
 Relocaliser::Result Relocaliser::process(const PoseEstimate& session, const std::vector<Eigen::Vector3f>& cloud,

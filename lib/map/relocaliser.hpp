@@ -43,6 +43,10 @@ struct PoseHintConfig {
 
 const ConfigTable<PoseHintConfig>& poseHintConfigTable();
 
+// A pose in the map frame from a position and a heading (yaw about the map's z axis, degrees): how an operator
+// gives one (reloc.start.*, the set_pose command).
+Eigen::Isometry3d poseFromHeading(const Eigen::Vector3d& position, double heading_deg);
+
 struct RelocaliserConfig {
   int candidates = 25;           // ring-key neighbours ranked by Scan Context distance per query
   int max_verifications = 4;     // best candidates verified by ICP per query
@@ -140,8 +144,9 @@ class Relocaliser {
     std::optional<Eigen::Isometry3d> T_map_lidar;  // only when localised
   };
   // The robot is near this map pose at the next sweep processed (the operator's start pose; reloc.start sets
-  // one at construction): relocalising searches only within `radius` of it until the fix. Replaces any other.
-  void setPoseHint(const Eigen::Isometry3d& T_map_lidar, double radius);
+  // one at construction): relocalising searches only within `radius` (default reloc.start.radius) of it until
+  // the fix. Replaces any other.
+  void setPoseHint(const Eigen::Isometry3d& T_map_lidar, std::optional<double> radius = std::nullopt);
 
   // session: the run's own pose (mapper output) of the sweep; cloud: its deskewed points, lidar frame.
   Result process(const PoseEstimate& session, const std::vector<Eigen::Vector3f>& cloud, bool registration_failed);

@@ -36,9 +36,7 @@ class RelocaliserNode : public runtime::Node, public WritesProducts {
       MapBundle bundle = loadMapBundle(node.prior_map);
       const std::string mismatch = bundleSensorMismatch(bundle.summary, pipelineConfigKeys(config));
       if (!mismatch.empty()) throw BundleError(node.prior_map + ": " + mismatch);
-      const RelocaliserConfig reloc = relocaliserConfigTable().read(config);
-      start_radius_ = reloc.start.radius;
-      relocaliser_.emplace(std::move(bundle), loopCloserConfigFrom(config), reloc);
+      relocaliser_.emplace(std::move(bundle), loopCloserConfigFrom(config), relocaliserConfigTable().read(config));
       spdlog::info("[relocaliser] map bundle {}: {} keyframes, {:.0f} m of roadway", node.prior_map,
                    relocaliser_->bundle().summary.keyframes, relocaliser_->bundle().summary.roadway_length_m);
     } catch (const BundleError& e) {
@@ -79,24 +77,19 @@ class RelocaliserNode : public runtime::Node, public WritesProducts {
       v.push_back(std::strtod(word.c_str(), &end));
       numbers = numbers && end != word.c_str() && *end == '\0' && std::isfinite(v.back());
     }
-    const double radius = v.size() == 5 ? v[4] : start_radius_;
-    if (!numbers || (v.size() != 4 && v.size() != 5) || radius <= 0) {
+    const std::optional<double> radius = v.size() == 5 ? std::optional<double>(v[4]) : std::nullopt;
+    if (!numbers || (v.size() != 4 && v.size() != 5) || (radius && *radius <= 0)) {
       reportError("command_refused", "set_pose '" + runtime::printableText(m.argument) +
                                          "' refused: expected X Y Z HEADING_DEG [RADIUS], finite, RADIUS > 0");
       return;
     }
-    const double x = v[0], y = v[1], z = v[2], heading_deg = v[3];
     if (!relocaliser_) {
       reportError("command_refused", "set_pose: no map bundle to place the pose in");
       return;
     }
-    Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
-    pose.translation() = Eigen::Vector3d(x, y, z);
-    pose.linear() = Eigen::AngleAxisd(heading_deg * M_PI / 180.0, Eigen::Vector3d::UnitZ()).toRotationMatrix();
-    relocaliser_->setPoseHint(pose, radius);
+    relocaliser_->setPoseHint(poseFromHeading(Eigen::Vector3d(v[0], v[1], v[2]), v[3]), radius);
     count("poses_set");
-    spdlog::info("[relocaliser] told it is within {:.1f} m of ({:.1f}, {:.1f}, {:.1f}), heading {:.0f} deg", radius, x, y, z,
-                 heading_deg);
+    spdlog::info("[relocaliser] told it is near ({:.1f}, {:.1f}, {:.1f}), heading {:.0f} deg", v[0], v[1], v[2], v[3]);
   }
 
   void onMapped(const adit::odometry_t& m) {
@@ -168,7 +161,6 @@ class RelocaliserNode : public runtime::Node, public WritesProducts {
   }
 
   std::optional<Relocaliser> relocaliser_;
-  double start_radius_ = PoseHintConfig{}.radius;
   Trajectory in_map_;
   std::int64_t first_utime_ = -1;
   std::optional<std::int64_t> first_fix_;
