@@ -21,14 +21,15 @@ trap '[ -n "$LAN_LOGGER" ] && kill "$LAN_LOGGER" 2>/dev/null; rm -rf "$WORK"' EX
 LOCAL='udpm://239.255.76.67:7667?ttl=0&recv_buf_size=8388608'
 LAN='udpm://239.255.76.68:7668?ttl=1'
 SIM_S=8
+source "$ROOT/tests/integration/time_scale.sh"
 
 lcm-logger -q -f --lcm-url="$LAN&recv_buf_size=8388608" "$WORK/lan.lcmlog" &
 LAN_LOGGER=$!
 ADIT_LCM_URL="$LOCAL" "$BIN/adit" launch "$ROOT/launch/live.launch.yaml" --set RECORD='.*' --set LAN_URL="$LAN" \
-  --log-dir "$WORK" --quiet --duration $((SIM_S + 8)) &
+  --log-dir "$WORK" --quiet --duration "$(scaled $((SIM_S + 8)))" &
 LAUNCH=$!
-sleep 3
-"$BIN/adit" sim --live --lcm-url "$LOCAL" --world roadway-loop --sensor vlp16 --duration $SIM_S --seed 4
+sleep "$(scaled 3)"
+"$BIN/adit" sim --live --lcm-url "$LOCAL" --world roadway-loop --sensor vlp16 --duration $SIM_S --seed 4 --rate "$RATE"
 wait $LAUNCH
 kill -INT "$LAN_LOGGER"; wait "$LAN_LOGGER" || true; LAN_LOGGER=
 RUN=$(ls -d "$WORK"/live-*)

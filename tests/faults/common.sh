@@ -5,6 +5,7 @@
 set -euo pipefail
 BIN=$1 ROOT=$2
 FAULTS=$ROOT/tests/faults
+source "$ROOT/tests/integration/time_scale.sh"
 if [ -z "${ADIT_IN_NETNS:-}" ]; then
   exec bash "$ROOT/tests/integration/netns.sh" ${NETNS_FLAGS:-} bash "$0" "$@"
 fi
@@ -32,9 +33,9 @@ wait_launch() {
   LAUNCH_PID=
 }
 
-# wait_line OUT REGEX SECONDS: prints the first launcher line matching REGEX; fails after SECONDS.
+# wait_line OUT REGEX SECONDS: prints the first launcher line matching REGEX; fails after SECONDS (scaled).
 wait_line() {
-  local deadline=$((SECONDS + $3)) line
+  local deadline=$((SECONDS + $(scaled "$3"))) line
   while [ $SECONDS -lt $deadline ]; do
     if line=$(grep -E -m1 "$2" "$1"); then echo "$line"; return 0; fi
     sleep 0.2

@@ -11,11 +11,12 @@ BIN=$1 SRC=$2
 URL="udpm://239.255.76.67:7667?ttl=0"
 WORK=$(mktemp -d)
 trap '[ -n "${KEEP:-}" ] || rm -rf "$WORK"' EXIT
+source "$SRC/tests/integration/time_scale.sh"
 "$BIN/adit" sim --config "$SRC/tests/live/small_loop.yaml" --duration 1 -o "$WORK/probe.lcmlog" \
   --world-pcd "$WORK/world.pcd" >/dev/null 2>&1
 "$BIN/adit" launch "$SRC/tests/live/loop_map.launch.yaml" --log-dir "$WORK" --quiet &
 LAUNCH=$!
-sleep 60  # sensor time ~59 s: 115 m driven of the 140 m lap, the start not yet in sight
+sleep "$(scaled 60)"  # sensor time ~59 s: 115 m driven of the 140 m lap, the start not yet in sight
 "$BIN/adit" command save_map before_loop --lcm-url "$URL"
 wait "$LAUNCH" || true
 RUN=$(ls -d "$WORK"/loop-*)

@@ -17,10 +17,11 @@ ip route add 224.0.0.0/4 dev lo
 
 WORK=$(mktemp -d)
 trap '[ -n "${KEEP:-}" ] || rm -rf "$WORK"' EXIT
+source "$SRC/tests/integration/time_scale.sh"
 "$BIN/adit" launch "$SRC/launch/sim.launch.yaml" --set DURATION="$DURATION" --log-dir "$WORK" --quiet &
 LAUNCH=$!
 killStage() {  # process name, seconds after start: kill -9 the launcher's child running it
-  sleep "$2"
+  sleep "$(scaled "$2")"
   local pid
   pid=$(pgrep -P "$LAUNCH" -f "$1" || true)
   if [ -n "$pid" ]; then echo "kill -9 $1 (pid $pid) at ${2}s"; kill -9 "$pid"; else echo "FAIL: no $1 to kill"; fi
@@ -37,7 +38,7 @@ for p in odometry mapper loop_closer; do
   line=$(grep "^restart $p " "$WORK/report.txt" || true)
   if [ -z "$line" ]; then echo "FAIL: $p did not report a restart on STATUS"; failed=1; continue; fi
   after=$(sed -E 's/.*first_output_after_s=([0-9.]+).*/\1/' <<<"$line")
-  if awk -v a="$after" 'BEGIN { exit !(a <= 2.0) }'; then echo "ok: $p publishing ${after} s after its restart";
+  if awk -v a="$after" -v l="$(scaled 2)" 'BEGIN { exit !(a <= l) }'; then echo "ok: $p publishing ${after} s after its restart";
   else echo "FAIL: $p took ${after} s to publish after its restart"; failed=1; fi
 done
 grep -q "recovered_keyframes=[1-9]" "$WORK/report.txt" && echo "ok: loop closer kept its keyframes" ||
