@@ -95,7 +95,7 @@ LoopCloser::Result LoopCloser::process(const PoseEstimate& mapped, const LidarSc
       result.keyframe_added = true;
       submitJob(k, context);  // the job keeps its own copy of the cloud
       if (revisit) {
-        keyframes_.back().cloud = CompactCloud::encode({}, static_cast<float>(config_.keyframe_cloud_step));
+        clouds_.drop(k);
         ++stats_.revisit_keyframes;
       }
     }
@@ -133,7 +133,7 @@ void LoopCloser::submitJob(int query, const ScanContext& context) {
     const Eigen::Isometry3d T_m_world = graph_.pose(m).inverse();
     for (int j = std::max(0, m - config_.verifier.submap_neighbors);
          j <= std::min(newest_allowed, m + config_.verifier.submap_neighbors); ++j) {
-      snap.neighbourhood.clouds.push_back(keyframes_[static_cast<std::size_t>(j)].cloud);
+      snap.neighbourhood.clouds.push_back(clouds_.cloud(j));
       snap.neighbourhood.T_match_cloud.push_back(T_m_world * graph_.pose(j));
     }
     job.candidates.push_back(std::move(snap));
@@ -145,7 +145,7 @@ void LoopCloser::submitJob(int query, const ScanContext& context) {
   job.query = query;
   job.query_utime = q.utime;
   job.query_uncorrected = q.uncorrected;
-  job.query_cloud = q.cloud;
+  job.query_cloud = clouds_.cloud(query);
   job.graph = graph_;
   job.chain = chain_;
   job.applied_loops = accepted_.size();
@@ -221,7 +221,7 @@ bool LoopCloser::isRevisit(int keyframe) const {
   const Eigen::Vector3d here = graph_.pose(keyframe).translation();
   const int older_than = keyframe - config_.exclude_recent_keyframes;
   for (int j = 0; j < older_than; ++j) {
-    if (!keyframes_[static_cast<std::size_t>(j)].cloud.empty() &&
+    if (!clouds_.empty(j) &&
         (graph_.pose(j).translation() - here).norm() < config_.revisit_distance)
       return true;
   }
@@ -238,8 +238,6 @@ ScanContext LoopCloser::addKeyframe(const PoseEstimate& mapped, const LidarScan&
   Keyframe kf;
   kf.utime = mapped.utime;
   kf.uncorrected = mapped.pose;
-  kf.cloud = CompactCloud::encode(voxelDownsample(points, config_.keyframe_voxel),
-                                  static_cast<float>(config_.keyframe_cloud_step));
 
   if (keyframes_.empty()) {
     chain_.add(mapped.pose, Matrix6d::Zero());
@@ -254,6 +252,8 @@ ScanContext LoopCloser::addKeyframe(const PoseEstimate& mapped, const LidarScan&
   }
   sweeps_since_keyframe_.clear();
   keyframes_.push_back(std::move(kf));
+  clouds_.add(CompactCloud::encode(voxelDownsample(points, config_.keyframe_voxel),
+                                   static_cast<float>(config_.keyframe_cloud_step)));
   ++stats_.keyframes;
   return keyframeScanContext(std::move(points), mapped.pose, config_.level_scan_context, config_.scan_context);
 }
@@ -292,9 +292,9 @@ std::vector<Eigen::Vector3f> LoopCloser::correctedMap(double voxel) const {
   std::optional<VoxelAccumulator> grid;
   if (voxel > 0) grid.emplace(voxel);
   for (std::size_t k = 0; k < keyframes_.size(); ++k) {
-    if (keyframes_[k].cloud.empty()) continue;  // a revisit: its place is in an older keyframe's cloud
+    if (clouds_.empty(static_cast<int>(k))) continue;  // a revisit: its place is in an older keyframe's cloud
     const Eigen::Isometry3f T = graph_.pose(static_cast<int>(k)).cast<float>();
-    for (const Eigen::Vector3f& p : keyframes_[k].cloud.decode()) {
+    for (const Eigen::Vector3f& p : clouds_.cloud(static_cast<int>(k)).decode()) {
       if (grid) {
         grid->add(T * p);
       } else if (const Eigen::Vector3f w = T * p; w.allFinite()) {

@@ -17,6 +17,7 @@
 #include "core/config_table.hpp"
 #include "core/types.hpp"
 #include "loop/compact_cloud.hpp"
+#include "loop/keyframe_cloud_store.hpp"
 #include "loop/loop_verifier.hpp"
 #include "loop/odometry_chain.hpp"
 #include "loop/pose_graph.hpp"
@@ -176,9 +177,15 @@ class LoopCloser {
   struct Keyframe {
     std::int64_t utime = 0;
     Eigen::Isometry3d uncorrected = Eigen::Isometry3d::Identity();  // mapped T_world_lidar
-    CompactCloud cloud;  // downsampled, lidar frame
   };
   const std::vector<Keyframe>& keyframes() const { return keyframes_; }
+  // Keyframe k's cloud (downsampled, lidar frame; empty for a revisit), from memory or the page file.
+  CompactCloud keyframeCloud(int k) const { return clouds_.cloud(k); }
+  bool keyframeHasCloud(int k) const { return !clouds_.empty(k); }
+  // A live process's memory: all but the newest `resident` keyframe clouds go to a page file
+  // (loop/keyframe_cloud_store.hpp). Throws std::runtime_error if the file cannot be created.
+  void pageCloudsTo(const std::string& path, std::size_t resident) { clouds_.pageTo(path, resident); }
+  const KeyframeCloudStore& clouds() const { return clouds_; }
   const PoseGraph& graph() const { return graph_; }
   const ScanContext& keyframeContext(int keyframe) const { return database_.context(keyframe); }
   const std::vector<LoopConstraint>& acceptedLoops() const { return accepted_; }
@@ -207,6 +214,7 @@ class LoopCloser {
 
   LoopCloserConfig config_;
   std::vector<Keyframe> keyframes_;
+  KeyframeCloudStore clouds_;  // [k]: keyframe k's cloud
   OdometryChain chain_;
   PoseGraph graph_;
   ScanContextDatabase database_;

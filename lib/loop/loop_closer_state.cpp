@@ -64,7 +64,7 @@ std::string LoopCloser::keyframeRecord(int k) const {
   const Keyframe& kf = keyframes_[static_cast<std::size_t>(k)];
   w.put<std::int64_t>(kf.utime);
   w.putPose(kf.uncorrected);
-  putCompactCloud(w, kf.cloud);
+  putCompactCloud(w, clouds_.cloud(k));
   putScanContext(w, database_.context(k));
   w.putMatrix(chain_.stepCovariance(k));
   return w.bytes();
@@ -115,13 +115,13 @@ bool LoopCloser::restoreState(const std::string& state, const std::vector<std::s
     std::optional<CompactCloud> cloud = getCompactCloud(kr);
     std::optional<ScanContext> context = cloud ? getScanContext(kr) : std::nullopt;
     if (!context) return false;
-    kf.cloud = std::move(*cloud);
     const Matrix6d step = kr.getMatrix<Matrix6d>();
     if (!kr.ok() || !kr.atEnd()) return false;
     restored.chain_.add(kf.uncorrected, step);
     restored.graph_.addNode(r.getPose());
     restored.database_.add(*context, kf.utime);
     restored.keyframes_.push_back(std::move(kf));
+    restored.clouds_.add(std::move(*cloud));
   }
   const auto edges = r.getCount(4 + 4 + 96 + 288 + 1);
   for (std::uint64_t i = 0; i < edges && r.ok(); ++i) {
@@ -145,8 +145,9 @@ bool LoopCloser::restoreState(const std::string& state, const std::vector<std::s
   for (int* field : statFields(restored.stats_)) *field = r.get<std::int32_t>();
   if (!r.ok() || !r.atEnd()) return false;
   // Not a saved field (older checkpoints lack it): a revisit keyframe is the one record without a cloud.
-  restored.stats_.revisit_keyframes = static_cast<int>(std::count_if(
-      restored.keyframes_.begin(), restored.keyframes_.end(), [](const Keyframe& k) { return k.cloud.empty(); }));
+  restored.stats_.revisit_keyframes = 0;
+  for (int k = 0; k < static_cast<int>(restored.clouds_.size()); ++k)
+    restored.stats_.revisit_keyframes += restored.clouds_.empty(k) ? 1 : 0;
   restored.stats_.partial_loops =
       static_cast<int>(std::count_if(restored.accepted_.begin(), restored.accepted_.end(), isPartialLoop));
   *this = std::move(restored);

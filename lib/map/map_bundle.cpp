@@ -187,7 +187,7 @@ MapBundle bundleFrom(const LoopCloser& closer, double map_voxel, const std::map<
   std::vector<Eigen::Vector3d> positions;
   for (std::size_t k = 0; k < closer.keyframes().size(); ++k) {
     const int id = static_cast<int>(k);
-    b.keyframes.push_back({closer.keyframes()[k].utime, closer.graph().pose(id), closer.keyframes()[k].cloud,
+    b.keyframes.push_back({closer.keyframes()[k].utime, closer.graph().pose(id), closer.keyframeCloud(static_cast<int>(k)),
                            closer.keyframeContext(id)});
     positions.push_back(closer.graph().pose(id).translation());
   }

@@ -41,7 +41,7 @@ std::optional<MapUpdate> MapUpdateTracker::update(std::int64_t utime, const Loop
   std::size_t points = 0;
   while (sent_.size() < keyframes.size()) {
     const std::size_t k = sent_.size();
-    std::vector<Eigen::Vector3f> decimated = voxelDownsample(keyframes[k].cloud.decode(), config_.voxel_m);
+    std::vector<Eigen::Vector3f> decimated = voxelDownsample(closer.keyframeCloud(static_cast<int>(k)).decode(), config_.voxel_m);
     // Always at least one submap per update, so a huge one cannot stall the stream.
     if (!out.added.empty() && points + decimated.size() > static_cast<std::size_t>(config_.max_points)) break;
     points += decimated.size();

@@ -37,6 +37,7 @@ class LoopCloserNode : public runtime::Node, public WritesProducts, public Write
       : Node("loop_closer"), closer_(loopCloserConfigFrom(config)),
         map_voxel_(loopCloserNodeConfigTable().read(config).map_voxel),
         checkpoint_keyframes_(loopCloserNodeConfigTable().read(config).checkpoint_keyframes),
+        clouds_in_memory_(loopCloserNodeConfigTable().read(config).clouds_in_memory),
         updates_(mapUpdateConfigFrom(config)), config_keys_(pipelineConfigKeys(config)),
         reloc_(relocNodeConfigTable().read(config)), state_("loop_closer") {
     subscribe<adit::odometry_t>("mapped", "ODOM_MAPPED", [this](const adit::odometry_t& m) { onMapped(m); });
@@ -91,6 +92,14 @@ class LoopCloserNode : public runtime::Node, public WritesProducts, public Write
     } else if (!error.empty()) {
       reportError("checkpoint_refused", error);
     }
+    // Paged after the resume: the checkpoint's keyframes come back into memory and the oldest go out again.
+    if (clouds_in_memory_ > 0) {
+      try {
+        closer_.pageCloudsTo(folder.file("loop_closer.clouds"), static_cast<std::size_t>(clouds_in_memory_));
+      } catch (const std::exception& e) {
+        reportError("cloud_paging_failed", std::string(e.what()) + " (keyframe clouds stay in memory)");
+      }
+    }
   }
 
   std::string state() const override { return health().counters.count("restarted") ? "restarted" : "running"; }
@@ -139,6 +148,11 @@ class LoopCloserNode : public runtime::Node, public WritesProducts, public Write
     setCount("rejected_odometry_gate", s.rejected_odometry);
     setCount("rejected_pairwise", s.rejected_pairwise);
     setCount("invalid_sweeps", s.invalid_sweeps);
+    const KeyframeCloudStore& clouds = closer_.clouds();
+    setCount("cloud_memory_kb", static_cast<std::int64_t>(clouds.residentBytes() / 1024));
+    setCount("clouds_paged", static_cast<std::int64_t>(clouds.pagedClouds()));
+    setCount("cloud_page_errors", static_cast<std::int64_t>(clouds.pageErrors()));
+    setCount("cloud_read_errors", static_cast<std::int64_t>(clouds.readErrors()));
   }
 
   void publishResult(std::int64_t utime, const LoopCloser::Result& result) {
@@ -309,6 +323,7 @@ class LoopCloserNode : public runtime::Node, public WritesProducts, public Write
   LoopCloser closer_;
   double map_voxel_;
   int checkpoint_keyframes_;
+  int clouds_in_memory_;
   MapUpdateTracker updates_;
   std::map<std::string, std::string> config_keys_;  // every pipeline key, for the bundle's config.yaml
   RelocNodeConfig reloc_;

@@ -1,10 +1,15 @@
 // Keyframe clouds kept as int16 counts (loop/compact_cloud.hpp): the round trip stays within half a step,
-// far points coarsen the step instead of wrapping around, malformed stored clouds are refused.
+// far points coarsen the step instead of wrapping around, malformed stored clouds are refused; the store of a
+// loop closer's clouds pages them to a file and reads back what it wrote.
 #include "loop/compact_cloud.hpp"
+#include "loop/keyframe_cloud_store.hpp"
 
 #include <gtest/gtest.h>
+#include <sys/resource.h>
 
 #include <cmath>
+#include <csignal>
+#include <filesystem>
 #include <limits>
 #include <random>
 
@@ -77,3 +82,73 @@ TEST(CompactCloud, StoredCountsOfBadSizeOrStepAreRefused) {
 
 }  // namespace
 }  // namespace adit
+
+// --- KeyframeCloudStore: the loop closer's clouds, in memory or paged to a file ---
+
+namespace {
+
+adit::CompactCloud cloudOf(int k) {
+  std::vector<Eigen::Vector3f> points;
+  for (int i = 0; i < 50 + k; ++i) points.emplace_back(0.1f * static_cast<float>(i), static_cast<float>(k), -1.0f);
+  return adit::CompactCloud::encode(points, 0.005f);
+}
+
+}  // namespace
+
+TEST(KeyframeCloudStore, PagedCloudsReadBackAsWritten) {
+  adit::KeyframeCloudStore store;
+  for (int k = 0; k < 5; ++k) store.add(cloudOf(k));
+  const std::string path = ::testing::TempDir() + "store_test.clouds";
+  store.pageTo(path, 3);
+  EXPECT_FALSE(std::filesystem::exists(path)) << "the page file is unlinked at once";
+  for (int k = 5; k < 20; ++k) store.add(cloudOf(k));
+  store.drop(7);
+  EXPECT_EQ(store.pagedClouds(), 17u);
+  EXPECT_EQ(store.size(), 20u);
+  for (int k = 0; k < 20; ++k) {
+    if (k == 7) {
+      EXPECT_TRUE(store.empty(k));
+      EXPECT_TRUE(store.cloud(k).empty());
+      continue;
+    }
+    EXPECT_FALSE(store.empty(k));
+    EXPECT_EQ(store.cloud(k).counts(), cloudOf(k).counts()) << k;
+    EXPECT_EQ(store.cloud(k).step(), cloudOf(k).step()) << k;
+  }
+  // Moved, and paged again to a new file: nothing lost.
+  adit::KeyframeCloudStore moved = std::move(store);
+  moved.pageTo(path + "2", 1);
+  for (int k = 0; k < 20; ++k) {
+    if (k != 7) {
+      EXPECT_EQ(moved.cloud(k).counts(), cloudOf(k).counts()) << k;
+    }
+  }
+  EXPECT_EQ(moved.readErrors(), 0u);
+  EXPECT_LT(moved.residentBytes(), 4096u) << "one cloud and the per-keyframe slots";
+}
+
+TEST(KeyframeCloudStore, AFailedPageWriteKeepsTheCloudInMemory) {
+  // A file size limit makes every write to the page file fail (EFBIG), as a full disk would.
+  std::signal(SIGXFSZ, SIG_IGN);
+  rlimit old{};
+  ASSERT_EQ(getrlimit(RLIMIT_FSIZE, &old), 0);
+  rlimit tiny = old;
+  tiny.rlim_cur = 100;  // bytes: less than one cloud
+  adit::KeyframeCloudStore store;
+  store.pageTo(::testing::TempDir() + "store_full.clouds", 0);
+  ASSERT_EQ(setrlimit(RLIMIT_FSIZE, &tiny), 0);
+  for (int k = 0; k < 4; ++k) store.add(cloudOf(k));
+  ASSERT_EQ(setrlimit(RLIMIT_FSIZE, &old), 0);
+  EXPECT_GE(store.pageErrors(), 1u);
+  for (int k = 0; k < 4; ++k) EXPECT_EQ(store.cloud(k).counts(), cloudOf(k).counts()) << k;
+  store.add(cloudOf(4));  // the limit lifted: the backlog goes out
+  EXPECT_EQ(store.pagedClouds(), 5u);
+  for (int k = 0; k < 5; ++k) EXPECT_EQ(store.cloud(k).counts(), cloudOf(k).counts()) << k;
+}
+
+TEST(KeyframeCloudStore, AnUncreatablePageFileThrows) {
+  adit::KeyframeCloudStore store;
+  store.add(cloudOf(0));
+  EXPECT_THROW(store.pageTo("/nonexistent-folder/x.clouds", 0), std::runtime_error);
+  EXPECT_EQ(store.cloud(0).counts(), cloudOf(0).counts());
+}

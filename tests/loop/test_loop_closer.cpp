@@ -189,14 +189,14 @@ TEST(LoopCloser, RevisitedKeyframesKeepOnlyTheirGraphNode) {
   printStats(thin.closer.stats());
   const auto& keyframes = thin.closer.keyframes();
   std::size_t first_lap_points = 0, later_points = 0;
-  for (std::size_t k = 0; k < keyframes.size(); ++k) (k < 140 ? first_lap_points : later_points) += keyframes[k].cloud.size();
+  for (std::size_t k = 0; k < keyframes.size(); ++k) (k < 140 ? first_lap_points : later_points) += thin.closer.keyframeCloud(static_cast<int>(k)).size();
   const int revisits = thin.closer.stats().revisit_keyframes;
   std::printf("revisit keyframes %d of %zu; cloud points: first lap %zu, after it %zu\n", revisits, keyframes.size(),
               first_lap_points, later_points);
   EXPECT_EQ(all.closer.stats().revisit_keyframes, 0);
   EXPECT_GE(revisits, 40) << "most of the 70 keyframes after the first lap revisit it";
   EXPECT_LT(later_points, first_lap_points / 4);
-  for (std::size_t k = 0; k < 140; ++k) EXPECT_FALSE(keyframes[k].cloud.empty()) << "first lap keyframe " << k;
+  for (std::size_t k = 0; k < 140; ++k) EXPECT_TRUE(thin.closer.keyframeHasCloud(static_cast<int>(k))) << "first lap keyframe " << k;
   // Loops still close (against the first lap), none false, and the correction is as good as keeping everything.
   EXPECT_GE(thin.closer.stats().accepted, 3);
   EXPECT_EQ(thin.false_loops, 0);
@@ -224,6 +224,23 @@ TEST(LoopCloser, RevisitedKeyframesKeepOnlyTheirGraphNode) {
   EXPECT_EQ(restored.stats().revisit_keyframes, revisits);
   for (int k = 0; k < static_cast<int>(keyframes.size()); ++k)
     EXPECT_EQ(restored.keyframeRecord(k), records[static_cast<std::size_t>(k)]) << k;
+
+  // Clouds paged to a file (a live process) give the same graph, records and map, from a fraction of the memory.
+  Drive paged{LoopCloser{testConfig()}, 0, {}};
+  paged.closer.pageCloudsTo(::testing::TempDir() + "loop_closer_test.clouds", 10);
+  drive(paged, world, truth, mapped);
+  const KeyframeCloudStore& store = paged.closer.clouds();
+  std::printf("paged: %zu clouds in the page file (%llu bytes), %zu kB in memory vs %zu kB unpaged\n",
+              store.pagedClouds(), static_cast<unsigned long long>(store.pageFileBytes()), store.residentBytes() / 1024,
+              thin.closer.clouds().residentBytes() / 1024);
+  EXPECT_EQ(paged.closer.saveState(), thin.closer.saveState());
+  for (int k = 0; k < static_cast<int>(keyframes.size()); ++k)
+    EXPECT_EQ(paged.closer.keyframeRecord(k), records[static_cast<std::size_t>(k)]) << k;
+  EXPECT_EQ(paged.closer.correctedMap(0.5), map_thin);
+  EXPECT_GE(store.pagedClouds(), 120u);
+  EXPECT_LT(store.residentBytes(), thin.closer.clouds().residentBytes() / 5);
+  EXPECT_EQ(store.readErrors(), 0u);
+  EXPECT_EQ(store.pageErrors(), 0u);
 }
 
 TEST(LoopCloser, RejectsAPeriodicRoadway) {
