@@ -13,6 +13,7 @@
 #include "nodes/products.hpp"
 #include "nodes/registry.hpp"
 #include "nodes/run_state.hpp"
+#include "nodes/trajectory_log.hpp"
 #include "runtime/record_log.hpp"
 
 #include <adit/command_t.hpp>
@@ -53,7 +54,7 @@ class LoopCloserNode : public runtime::Node, public WritesProducts, public Write
   }
 
   std::vector<std::string> writeProducts(const std::string& out_dir) override {
-    return writeMapProducts(closer_, uncorrected_, map_voxel_, out_dir);
+    return writeMapProducts(closer_, uncorrected(), map_voxel_, out_dir);
   }
   bool writesMap() const override { return true; }
   // The run's own map, or (extending a saved map) the saved map joined with this run's new roadway.
@@ -65,7 +66,7 @@ class LoopCloserNode : public runtime::Node, public WritesProducts, public Write
       prior = loadMapBundle(reloc_.prior_map);
       if (reloc_.extend.hold_saved_map) prior.map = loadBundleMap(reloc_.prior_map);  // else redrawn from keyframes
       BundleExtendReport r;
-      MapBundle both = extendBundle(prior, run, closer_.correctedTrajectory(uncorrected_), anchors_, reloc_.extend, &r);
+      MapBundle both = extendBundle(prior, run, closer_.correctedTrajectory(uncorrected()), anchors_, reloc_.extend, &r);
       setCount("extend_anchors_used", r.anchors_used);
       setCount("extend_keyframes_added", r.kept_keyframes);
       setCount("extend_keyframes_overlap", r.overlap_keyframes);
@@ -88,7 +89,7 @@ class LoopCloserNode : public runtime::Node, public WritesProducts, public Write
       setCount("recovered_keyframes", closer_.stats().keyframes);
       setCount("recovered_loops", static_cast<std::int64_t>(closer_.acceptedLoops().size()));
       spdlog::info("[loop_closer] resumed from {}: {} keyframes, {} loops, {} sweeps", state_.checkpointPath(),
-                   closer_.stats().keyframes, closer_.acceptedLoops().size(), uncorrected_.size());
+                   closer_.stats().keyframes, closer_.acceptedLoops().size(), trajectory_.size());
     } else if (!error.empty()) {
       reportError("checkpoint_refused", error);
     }
@@ -107,7 +108,7 @@ class LoopCloserNode : public runtime::Node, public WritesProducts, public Write
  protected:
   void onFinish() override {
     // Loop jobs still in flight are applied (and published) before anything is saved, live and in replay.
-    if (!uncorrected_.empty()) publishResult(uncorrected_.back().utime, closer_.finish());
+    if (!trajectory_.empty()) publishResult(trajectory_.back().utime, closer_.finish());
     if (!state_.live()) return;  // replay writes its products itself
     saveProducts({});  // first: what the user asked for, before the stop's grace time runs out
     checkpoint();
@@ -127,7 +128,7 @@ class LoopCloserNode : public runtime::Node, public WritesProducts, public Write
     // The graph is built on uncorrected poses: undo the correction the mapper had already applied.
     mapped.pose = makePose(m.loop_correction_position, m.loop_correction_orientation).inverse() * mapped.pose;
     const LidarScan cloud = msg::featuresOf(m).cloud;
-    uncorrected_.push_back({mapped.utime, mapped.pose});
+    trajectory_.push_back({mapped.utime, mapped.pose});
     const LoopCloser::Result result = closer_.process(mapped, cloud);
     publishResult(mapped.utime, result);
     if (const auto update = updates_.update(mapped.utime, closer_)) publishMapUpdate(*update);
@@ -135,6 +136,7 @@ class LoopCloserNode : public runtime::Node, public WritesProducts, public Write
     const bool periodic = result.keyframe_added && checkpoint_keyframes_ > 0 && s.keyframes % checkpoint_keyframes_ == 0;
     if (state_.live() && (periodic || result.graph_updated)) checkpoint();
     if (state_.live()) reportCheckpoints();
+    trajectory_.release();
     // Wall time the sweeps waited for the loop worker: STATUS only (replay's products never carry it).
     setCount("loop_jobs_in_flight", static_cast<std::int64_t>(closer_.jobsInFlight()));
     setCount("loop_wait_ms", static_cast<std::int64_t>(closer_.waitedMs()));
@@ -153,6 +155,7 @@ class LoopCloserNode : public runtime::Node, public WritesProducts, public Write
     setCount("clouds_paged", static_cast<std::int64_t>(clouds.pagedClouds()));
     setCount("cloud_page_errors", static_cast<std::int64_t>(clouds.pageErrors()));
     setCount("cloud_read_errors", static_cast<std::int64_t>(clouds.readErrors()));
+    setCount("trajectory_poses_in_memory", static_cast<std::int64_t>(trajectory_.inMemory()));
   }
 
   void publishResult(std::int64_t utime, const LoopCloser::Result& result) {
@@ -200,7 +203,7 @@ class LoopCloserNode : public runtime::Node, public WritesProducts, public Write
 
   void saveProducts(const MapProductNames& names) {
     try {
-      writeMapProducts(closer_, uncorrected_, map_voxel_, state_.folder().dir, names);
+      writeMapProducts(closer_, uncorrected(), map_voxel_, state_.folder().dir, names);
       count("maps_saved");
       spdlog::info("[loop_closer] saved {} keyframes, {} loops: {}, {}, {} in {}", closer_.stats().keyframes,
                    closer_.acceptedLoops().size(), names.map, names.trajectory, names.graph, state_.folder().dir);
@@ -218,21 +221,19 @@ class LoopCloserNode : public runtime::Node, public WritesProducts, public Write
     std::vector<std::string> records;
     for (std::size_t k = first; k < closer_.keyframes().size(); ++k)
       records.push_back(closer_.keyframeRecord(static_cast<int>(k)));
+    TrajectoryLog::Chunk poses = trajectory_.unwritten();
     ByteWriter w;
     w.putString(closer_.saveState());
-    w.put<std::uint64_t>(uncorrected_.size());
-    for (const StampedPose& p : uncorrected_) {
-      w.put<std::int64_t>(p.utime);
-      w.putPose(p.pose);
-    }
-    state_.submit([this, first, records = std::move(records), payload = w.bytes()] {
+    w.put<std::uint64_t>(poses.first + poses.poses.size());  // the trajectory's length, its poses in the log
+    state_.submit([this, first, records = std::move(records), poses = std::move(poses), payload = w.bytes()] {
       try {
         if (!keyframes_log_.isOpen()) keyframes_log_.create(keyframesPath(), kKeyframesKind, state_.folder().run_id);
         if (first > keyframes_log_.size()) return std::string("keyframe log behind its checkpoint");
         keyframes_log_.append({records.begin() + static_cast<std::ptrdiff_t>(keyframes_log_.size() - first), records.end()});
         keyframes_written_->store(keyframes_log_.size());
+        trajectory_.write(poses, trajectoryPath(), state_.folder().run_id);
       } catch (const std::exception& e) {
-        return std::string("keyframes not written: ") + e.what();  // the previous checkpoint still matches
+        return std::string("keyframes or trajectory not written: ") + e.what();  // the previous checkpoint still matches
       }
       return state_.save(payload);
     });
@@ -246,11 +247,7 @@ class LoopCloserNode : public runtime::Node, public WritesProducts, public Write
   std::string restore(const std::string& bytes) {
     ByteReader r(bytes);
     const std::string state = r.getString();
-    Trajectory uncorrected(r.getCount(8 + 96));
-    for (StampedPose& p : uncorrected) {
-      p.utime = r.get<std::int64_t>();
-      p.pose = r.getPose();
-    }
+    const auto trajectory_length = r.get<std::uint64_t>();
     if (!r.ok() || !r.atEnd()) return "malformed checkpoint";
     const std::size_t n = LoopCloser::keyframesInState(state);
     const runtime::LoadedRecords records = runtime::loadRecords(keyframesPath(), kKeyframesKind, state_.folder().run_id, n);
@@ -260,6 +257,9 @@ class LoopCloserNode : public runtime::Node, public WritesProducts, public Write
              " keyframes the checkpoint names";
     LoopCloser closer(closer_.config());
     if (!closer.restoreState(state, records.records)) return "malformed loop closer state";
+    TrajectoryLog trajectory;
+    const std::string error = trajectory.restore(trajectoryPath(), state_.folder().run_id, trajectory_length);
+    if (!error.empty()) return error;
     try {
       keyframes_log_.continueAfter(keyframesPath(), n);  // cut keyframes written after the checkpoint
       keyframes_written_->store(n);
@@ -267,11 +267,14 @@ class LoopCloserNode : public runtime::Node, public WritesProducts, public Write
       return e.what();
     }
     closer_ = std::move(closer);
-    uncorrected_ = std::move(uncorrected);
+    trajectory_ = std::move(trajectory);
     return "";
   }
 
   std::string keyframesPath() const { return state_.folder().file("loop_closer.keyframes"); }
+  std::string trajectoryPath() const { return state_.folder().file("loop_closer.trajectory"); }
+  // The per-sweep mapped poses before loop correction, read back from the run folder's log where needed.
+  Trajectory uncorrected() const { return trajectory_.all(trajectoryPath(), state_.folder().run_id); }
 
   // One pose as a row of a message's position (3) and orientation (4) arrays.
   static void appendPose(const Eigen::Isometry3d& T, std::vector<std::vector<double>>& positions,
@@ -330,8 +333,8 @@ class LoopCloserNode : public runtime::Node, public WritesProducts, public Write
   Trajectory anchors_;  // extending: the relocaliser's measured poses in the saved map (one a metre, not checkpointed)
   runtime::RecordLog keyframes_log_;  // the writer thread's, once the run started
   std::shared_ptr<std::atomic<std::size_t>> keyframes_written_ = std::make_shared<std::atomic<std::size_t>>(0);
+  TrajectoryLog trajectory_;  // the per-sweep poses; its log is written on state_'s writer thread
   RunState state_;  // after what its jobs use: its writer thread stops first
-  Trajectory uncorrected_;
 };
 
 }  // namespace

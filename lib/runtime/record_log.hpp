@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace adit::runtime {
@@ -30,6 +31,16 @@ class RecordLog {
   ~RecordLog();
   RecordLog(const RecordLog&) = delete;
   RecordLog& operator=(const RecordLog&) = delete;
+  RecordLog(RecordLog&& other) noexcept { *this = std::move(other); }
+  RecordLog& operator=(RecordLog&& other) noexcept {
+    if (this != &other) {
+      if (file_) std::fclose(file_);
+      file_ = std::exchange(other.file_, nullptr);
+      path_ = std::move(other.path_);
+      count_ = std::exchange(other.count_, 0);
+    }
+    return *this;
+  }
 
   // Starts a new file (any old one is replaced), or continues one whose first `keep` records are valid
   // (anything after them is cut off). Throws std::runtime_error naming the file.
