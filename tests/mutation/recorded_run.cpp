@@ -3,7 +3,9 @@
 #include "core/geometry.hpp"
 #include "msg/convert.hpp"
 #include "msg/encode.hpp"
+#include "map/map_bundle.hpp"
 #include "msg/sweep_codec.hpp"
+#include "nodes/products.hpp"
 #include "nodes/registry.hpp"
 #include "runtime/lockstep.hpp"
 #include "sources/sim_source.hpp"
@@ -12,8 +14,11 @@
 #include <adit/odometry_t.hpp>
 #include <adit/pose_graph_t.hpp>
 
+#include <cmath>
+#include <filesystem>
 #include <memory>
 #include <stdexcept>
+#include <unistd.h>
 
 namespace adit::mutation {
 namespace {
@@ -58,7 +63,7 @@ RecordedRun recordRun(const Config& config, double seconds, int seed) {
   for (auto& n : nodes) bus.add(*n);
   RecordedRun run;
   std::vector<adit::odometry_t> keyframes;
-  std::int64_t last_keyframe = -1, graph_seq = 0, command_seq = 0;
+  std::int64_t last_keyframe = -1, graph_seq = 0, command_seq = 0, reloc_seq = 0;
   bus.observe([&](const std::string& channel, const runtime::Bytes& data, std::int64_t utime) {
     run.events.push_back({channel, data, utime});
     if (channel != "ODOM_MAPPED") return;
@@ -78,6 +83,18 @@ RecordedRun recordRun(const Config& config, double seconds, int seed) {
       c.argument = "snapshot";
       run.events.push_back({"MAPPER_COMMAND", msg::encode(c), utime});
     }
+    if (keyframes.size() % 2 == 1) {  // the operator's guess of where the robot is: here, 0.3 m and 4 deg off
+      const Eigen::Isometry3d pose = makePose(m.position, m.orientation);
+      const Eigen::Vector3d x = pose.linear().col(0);
+      adit::command_t c{};
+      c.header = msg::makeHeader(utime, "");
+      c.header.seq = reloc_seq++;
+      c.command = "set_pose";
+      c.argument = std::to_string(pose.translation().x() + 0.3) + " " + std::to_string(pose.translation().y()) + " " +
+                   std::to_string(pose.translation().z()) + " " +
+                   std::to_string(std::atan2(x.y(), x.x()) * 180.0 / 3.14159265358979323846 + 4.0);
+      run.events.push_back({"RELOC_COMMAND", msg::encode(c), utime});
+    }
   });
   runtime::OutgoingMessage m;
   while (source.next(m)) {
@@ -93,6 +110,14 @@ RecordedRun recordRun(const Config& config, double seconds, int seed) {
     bus.inject(m.channel, m.data, m.utime);
   }
   bus.finish();
+  for (std::size_t i = 0; i < nodes.size(); ++i) {
+    auto* owner = dynamic_cast<nodes::WritesBundle*>(nodes[i].get());
+    if (!owner || nodes::pipelineNodeNames()[i] != "loop_closer") continue;
+    run.bundle_dir = (std::filesystem::temp_directory_path() /
+                      ("adit_mutation_bundle_" + std::to_string(::getpid()) + "_" + std::to_string(seconds))).string();
+    writeMapBundle(owner->mapBundle(), run.bundle_dir);
+  }
+  if (run.bundle_dir.empty()) throw std::runtime_error("no loop closer wrote the run's map bundle");
   return run;
 }
 

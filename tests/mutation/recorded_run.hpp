@@ -21,6 +21,10 @@ struct Event {
 struct RecordedRun {
   std::vector<Event> events;  // bus order; LIDAR_POINTS compact
   std::vector<Event> full_sweeps;  // the same sweeps as point_cloud_t, one per compact LIDAR_POINTS event, in order
+  // The run's own map bundle (its loop closer's, written at the end) in a temporary folder: the relocaliser's
+  // reloc.prior_map, so that it relocalises in the very roadway the recorded messages drive through. The
+  // caller removes it.
+  std::string bundle_dir;
 };
 
 RecordedRun recordRun(const Config& config, double seconds, int seed);
