@@ -11,31 +11,26 @@
 namespace adit {
 namespace {
 
-// pwrite/pread of the whole buffer (they may transfer less than asked); false on an error or end of file.
-bool writeAll(int fd, const void* data, std::size_t bytes, std::int64_t offset) {
-  const char* p = static_cast<const char*>(data);
+// pwrite or pread of the whole buffer (both may transfer less than asked); false on an error or end of file.
+template <class Buffer, class Transfer>
+bool transferAll(Transfer transfer, int fd, Buffer* data, std::size_t bytes, std::int64_t offset) {
   while (bytes > 0) {
-    const ssize_t n = ::pwrite(fd, p, bytes, static_cast<off_t>(offset));
+    const ssize_t n = transfer(fd, data, bytes, static_cast<off_t>(offset));
     if (n < 0 && errno == EINTR) continue;
     if (n <= 0) return false;
-    p += n;
+    data += n;
     bytes -= static_cast<std::size_t>(n);
     offset += n;
   }
   return true;
 }
 
+bool writeAll(int fd, const void* data, std::size_t bytes, std::int64_t offset) {
+  return transferAll(::pwrite, fd, static_cast<const char*>(data), bytes, offset);
+}
+
 bool readAll(int fd, void* data, std::size_t bytes, std::int64_t offset) {
-  char* p = static_cast<char*>(data);
-  while (bytes > 0) {
-    const ssize_t n = ::pread(fd, p, bytes, static_cast<off_t>(offset));
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) return false;
-    p += n;
-    bytes -= static_cast<std::size_t>(n);
-    offset += n;
-  }
-  return true;
+  return transferAll(::pread, fd, static_cast<char*>(data), bytes, offset);
 }
 
 }  // namespace
