@@ -36,9 +36,7 @@ class LoopCloserNode : public runtime::Node, public WritesProducts, public Write
  public:
   explicit LoopCloserNode(const Config& config)
       : Node("loop_closer"), closer_(loopCloserConfigFrom(config)),
-        map_voxel_(loopCloserNodeConfigTable().read(config).map_voxel),
-        checkpoint_keyframes_(loopCloserNodeConfigTable().read(config).checkpoint_keyframes),
-        clouds_in_memory_(loopCloserNodeConfigTable().read(config).clouds_in_memory),
+        node_(loopCloserNodeConfigTable().read(config)),
         updates_(mapUpdateConfigFrom(config)), config_keys_(pipelineConfigKeys(config)),
         reloc_(relocNodeConfigTable().read(config)), state_("loop_closer") {
     subscribe<adit::odometry_t>("mapped", "ODOM_MAPPED", [this](const adit::odometry_t& m) { onMapped(m); });
@@ -54,12 +52,12 @@ class LoopCloserNode : public runtime::Node, public WritesProducts, public Write
   }
 
   std::vector<std::string> writeProducts(const std::string& out_dir) override {
-    return writeMapProducts(closer_, uncorrected(), map_voxel_, out_dir);
+    return writeMapProducts(closer_, uncorrected(), node_.map_voxel, out_dir);
   }
   bool writesMap() const override { return true; }
   // The run's own map, or (extending a saved map) the saved map joined with this run's new roadway.
   MapBundle mapBundle() override {
-    MapBundle run = bundleFrom(closer_, map_voxel_, config_keys_);
+    MapBundle run = bundleFrom(closer_, node_.map_voxel, config_keys_);
     if (!reloc_.extending()) return run;
     MapBundle prior;
     try {
@@ -94,9 +92,9 @@ class LoopCloserNode : public runtime::Node, public WritesProducts, public Write
       reportError("checkpoint_refused", error);
     }
     // Paged after the resume: the checkpoint's keyframes come back into memory and the oldest go out again.
-    if (clouds_in_memory_ > 0) {
+    if (node_.clouds_in_memory > 0) {
       try {
-        closer_.pageCloudsTo(folder.file("loop_closer.clouds"), static_cast<std::size_t>(clouds_in_memory_));
+        closer_.pageCloudsTo(folder.file("loop_closer.clouds"), static_cast<std::size_t>(node_.clouds_in_memory));
       } catch (const std::exception& e) {
         reportError("cloud_paging_failed", std::string(e.what()) + " (keyframe clouds stay in memory)");
       }
@@ -133,7 +131,7 @@ class LoopCloserNode : public runtime::Node, public WritesProducts, public Write
     publishResult(mapped.utime, result);
     if (const auto update = updates_.update(mapped.utime, closer_)) publishMapUpdate(*update);
     const LoopCloserStats& s = closer_.stats();
-    const bool periodic = result.keyframe_added && checkpoint_keyframes_ > 0 && s.keyframes % checkpoint_keyframes_ == 0;
+    const bool periodic = result.keyframe_added && node_.checkpoint_keyframes > 0 && s.keyframes % node_.checkpoint_keyframes == 0;
     if (state_.live() && (periodic || result.graph_updated)) checkpoint();
     if (state_.live()) reportCheckpoints();
     trajectory_.release();
@@ -203,7 +201,7 @@ class LoopCloserNode : public runtime::Node, public WritesProducts, public Write
 
   void saveProducts(const MapProductNames& names) {
     try {
-      writeMapProducts(closer_, uncorrected(), map_voxel_, state_.folder().dir, names);
+      writeMapProducts(closer_, uncorrected(), node_.map_voxel, state_.folder().dir, names);
       count("maps_saved");
       spdlog::info("[loop_closer] saved {} keyframes, {} loops: {}, {}, {} in {}", closer_.stats().keyframes,
                    closer_.acceptedLoops().size(), names.map, names.trajectory, names.graph, state_.folder().dir);
@@ -324,9 +322,7 @@ class LoopCloserNode : public runtime::Node, public WritesProducts, public Write
   }
 
   LoopCloser closer_;
-  double map_voxel_;
-  int checkpoint_keyframes_;
-  int clouds_in_memory_;
+  LoopCloserNodeConfig node_;  // map voxel, checkpoint spacing, clouds kept in memory
   MapUpdateTracker updates_;
   std::map<std::string, std::string> config_keys_;  // every pipeline key, for the bundle's config.yaml
   RelocNodeConfig reloc_;
