@@ -34,7 +34,6 @@ class KeyframeCloudStore {
   // is, and a restart reads its keyframes from the checkpoint instead. Throws std::runtime_error if it cannot
   // be created. A failed write (disk full) keeps the cloud in memory and is counted (pageErrors()).
   void pageTo(const std::string& path, std::size_t resident);
-  bool paging() const { return fd_ >= 0; }
 
   std::size_t residentBytes() const;  // the clouds in memory and the per-keyframe slots
   std::size_t pagedClouds() const { return paged_; }

@@ -181,7 +181,6 @@ class LoopCloser {
   const std::vector<Keyframe>& keyframes() const { return keyframes_; }
   // Keyframe k's cloud (downsampled, lidar frame; empty for a revisit), from memory or the page file.
   CompactCloud keyframeCloud(int k) const { return clouds_.cloud(k); }
-  bool keyframeHasCloud(int k) const { return !clouds_.empty(k); }
   // A live process's memory: all but the newest `resident` keyframe clouds go to a page file
   // (loop/keyframe_cloud_store.hpp). Throws std::runtime_error if the file cannot be created.
   void pageCloudsTo(const std::string& path, std::size_t resident) { clouds_.pageTo(path, resident); }
