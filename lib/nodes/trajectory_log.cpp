@@ -71,11 +71,11 @@ Trajectory TrajectoryLog::all(const std::string& path, const std::string& run_id
   if (dropped_ == 0) return tail_;
   // Only records the writer finished are needed; one it is appending now is cut off as torn.
   const runtime::LoadedRecords loaded = runtime::loadRecords(path, kKind, run_id, SIZE_MAX);
+  if (!loaded.error.empty()) throw std::runtime_error(loaded.error);
   Trajectory out;
   out.reserve(size());
   std::size_t used = 0;
-  if (!loaded.error.empty()) throw std::runtime_error(loaded.error);
-  concatenate(loaded.records, dropped_, out, used);
+  concatenate(loaded.records, dropped_, out, used);  // may end past dropped_ (a record the tail also holds)
   if (out.size() < dropped_)
     throw std::runtime_error(path + " holds " + std::to_string(out.size()) + " of the trajectory's first " +
                              std::to_string(dropped_) + " poses");
