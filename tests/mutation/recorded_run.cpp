@@ -14,6 +14,7 @@
 #include <adit/odometry_t.hpp>
 #include <adit/pose_graph_t.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <memory>
@@ -110,14 +111,13 @@ RecordedRun recordRun(const Config& config, double seconds, int seed) {
     bus.inject(m.channel, m.data, m.utime);
   }
   bus.finish();
-  for (std::size_t i = 0; i < nodes.size(); ++i) {
-    auto* owner = dynamic_cast<nodes::WritesBundle*>(nodes[i].get());
-    if (!owner || nodes::pipelineNodeNames()[i] != "loop_closer") continue;
-    run.bundle_dir = (std::filesystem::temp_directory_path() /
-                      ("adit_mutation_bundle_" + std::to_string(::getpid()) + "_" + std::to_string(seconds))).string();
-    writeMapBundle(owner->mapBundle(), run.bundle_dir);
-  }
-  if (run.bundle_dir.empty()) throw std::runtime_error("no loop closer wrote the run's map bundle");
+  const auto& names = nodes::pipelineNodeNames();
+  const auto loop_closer = std::find(names.begin(), names.end(), "loop_closer") - names.begin();
+  auto* owner = dynamic_cast<nodes::WritesBundle*>(nodes.at(static_cast<std::size_t>(loop_closer)).get());
+  if (!owner) throw std::runtime_error("the loop closer does not write map bundles");
+  run.bundle_dir = (std::filesystem::temp_directory_path() /
+                    ("adit_mutation_bundle_" + std::to_string(::getpid()) + "_" + std::to_string(seconds))).string();
+  writeMapBundle(owner->mapBundle(), run.bundle_dir);
   return run;
 }
 
