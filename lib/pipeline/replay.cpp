@@ -8,7 +8,7 @@
 #include "nodes/products.hpp"
 #include "nodes/registry.hpp"
 #include "runtime/lcm_log.hpp"
-#include "runtime/lockstep.hpp"
+#include "runtime/pipelined_bus.hpp"
 #include "runtime/process.hpp"
 #include "runtime/source.hpp"
 
@@ -20,6 +20,7 @@
 #include <filesystem>
 #include <fstream>
 #include <memory>
+#include <mutex>
 #include <regex>
 #include <stdexcept>
 
@@ -156,12 +157,15 @@ ReplayReport runReplay(const ReplayOptions& options) {
   const auto nodes = buildNodes(options, report);
   Input input(options);
   runtime::LogWriter output((fs::path(options.out_dir) / "output.lcmlog").string());
-  runtime::LockstepBus bus;
+  runtime::PipelinedBus bus(options.pipelined);
   const std::regex record(options.record), record_poses(options.record_poses);
   // A failed write (disk full) happens inside a node's publish, where stage errors are counted and the run
   // goes on: keep it here and end the replay with it after the delivery (the writer has removed its file).
+  // The observer runs on the bus's worker thread when pipelined.
+  std::mutex write_error_mutex;
   std::string write_error;
   bus.observe([&](const std::string& channel, const runtime::Bytes& data, std::int64_t utime) {
+    std::lock_guard<std::mutex> lock(write_error_mutex);
     if (!write_error.empty()) return;
     try {
       if (std::regex_match(channel, record)) {
@@ -177,6 +181,7 @@ ReplayReport runReplay(const ReplayOptions& options) {
     }
   });
   const auto stopOnWriteError = [&] {
+    std::lock_guard<std::mutex> lock(write_error_mutex);
     if (!write_error.empty()) throw std::runtime_error(write_error);
   };
   for (const auto& node : nodes) bus.add(*node);

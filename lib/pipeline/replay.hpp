@@ -39,6 +39,9 @@ struct ReplayOptions {
   std::string save_bundle;
   // Called now and then with the fraction of the input consumed (progress bars).
   std::function<void(double)> on_progress;
+  // Run the feature stage and odometry of a sweep beside the mapper and loop closer of the sweep before, on
+  // two threads (runtime/pipelined_bus.hpp): the same output byte for byte, faster. false: one thread.
+  bool pipelined = true;
 };
 
 struct StageTiming {

@@ -24,6 +24,12 @@ std::vector<std::string> Node::inputChannels() const {
   return out;
 }
 
+std::vector<std::string> Node::outputChannels() const {
+  std::vector<std::string> out;
+  for (const auto& kv : seq_) out.push_back(channels_.at(kv.first));
+  return out;
+}
+
 bool Node::isInput(const std::string& channel) const {
   for (const auto& kv : inputs_)
     if (channels_.at(kv.first) == channel) return true;

@@ -90,6 +90,8 @@ class Node {
   const std::map<std::string, std::string>& channels() const { return channels_; }
   std::vector<std::string> inputChannels() const;
   bool isInput(const std::string& channel) const;
+  // Channels of the advertised output ports.
+  std::vector<std::string> outputChannels() const;
 
   // Hand one encoded message that arrived on `channel` to the node; its outputs go to `sink`.
   void deliver(const std::string& channel, const std::uint8_t* data, std::size_t size, Sink& sink);

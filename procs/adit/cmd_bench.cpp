@@ -100,6 +100,7 @@ struct PipelineBenchArgs {
   std::vector<std::string> configs;
   double duration_s = 60;
   bool live = false;
+  bool serial = false;
 };
 
 std::string shellQuoted(const std::string& s) {
@@ -164,6 +165,7 @@ void registerPipelineBench(CLI::App& bench) {
   cmd->add_option("--log", a->log, "Time this log instead of a simulation")->check(CLI::ExistingFile);
   cmd->add_option("--config", a->configs, "Configuration (default launch/config/pipeline.yaml)");
   cmd->add_option("--json", a->json, "Also write the figures to this JSON file (for adit bench compare)");
+  cmd->add_flag("--serial", a->serial, "Every stage on one thread (default: two pipelined groups, as adit replay)");
   cmd->add_flag("--live", a->live, "Run the real processes in real time over UDP in a private network namespace "
                                    "and report the LIDAR_POINTS -> ODOM_MAPPED latency from their STATUS");
   cmd->callback([a] {
@@ -179,6 +181,7 @@ void registerPipelineBench(CLI::App& bench) {
     options.config = adit::runtime::loadConfig(configs);
     options.out_dir = (fs::temp_directory_path() / ("adit_bench_" + std::to_string(::getpid()))).string();
     options.record = "^$";  // time the stages, not the disk
+    options.pipelined = !a->serial;
     std::unique_ptr<adit::sources::SimSource> sim;
     std::string input = a->log;
     if (a->log.empty()) {

@@ -26,6 +26,7 @@ struct ReplayArgs {
   std::string record_poses = "^(ODOM_SCAN|ODOM_MAPPED)$";
   bool record_all = false;
   bool no_progress = false;
+  bool serial = false;
   std::string save_bundle;
   std::string prior_map;
   bool extend = false;
@@ -81,6 +82,9 @@ void registerReplayCommand(CLI::App& app) {
                   "reloc.start.*): relocalise only within reloc.start.radius of it")
       ->expected(4);
   cmd->add_flag("--no-progress", args->no_progress, "No progress bar even on a terminal");
+  cmd->add_flag("--serial", args->serial,
+                "Every stage on one thread (default: feature stage and odometry beside mapper and loop closer; the "
+                "same output byte for byte)");
   cmd->callback([args] {
     adit::pipeline::ReplayOptions options;
     options.input_log = args->log;
@@ -89,6 +93,7 @@ void registerReplayCommand(CLI::App& app) {
     options.stages = args->stages;
     options.save_bundle = args->save_bundle;
     options.prior_map = args->prior_map;
+    options.pipelined = !args->serial;
     if (args->extend) {
       if (args->prior_map.empty() || args->save_bundle.empty())
         throw CLI::ValidationError("--extend", "needs --prior-map (the map to extend) and --save-bundle (where both go)");
