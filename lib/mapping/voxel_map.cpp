@@ -1,19 +1,77 @@
 #include "mapping/voxel_map.hpp"
 
 #include <algorithm>
-#include <map>
 
 namespace adit {
+namespace {
+
+constexpr std::size_t kInitialSlots = 64;
+
+// The spatial hash mixed so that its low bits, which pick the slot, depend on every bit of the key.
+std::size_t mixedHash(const VoxelKey& key) {
+  std::uint64_t h = VoxelKeyHash{}(key);
+  h ^= h >> 31;
+  h *= 0xbf58476d1ce4e5b9ULL;
+  h ^= h >> 29;
+  return static_cast<std::size_t>(h);
+}
+
+}  // namespace
 
 VoxelMap::VoxelMap(double voxel_size, double min_spacing, int max_points_per_voxel)
     : voxel_size_(voxel_size > 0 ? voxel_size : 1.0),
       min_spacing_sq_(min_spacing * min_spacing),
-      max_points_per_voxel_(std::max(1, max_points_per_voxel)) {}
+      max_points_per_voxel_(std::max(1, max_points_per_voxel)),
+      table_(kInitialSlots, kEmpty) {}
+
+std::size_t VoxelMap::slotOf(const VoxelKey& key) const {
+  const std::size_t mask = table_.size() - 1;
+  std::size_t slot = mixedHash(key) & mask;
+  while (table_[slot] != kEmpty && !(voxels_[static_cast<std::size_t>(table_[slot])].key == key)) slot = (slot + 1) & mask;
+  return slot;
+}
+
+const VoxelMap::Voxel* VoxelMap::find(const VoxelKey& key) const {
+  const std::int32_t index = table_[slotOf(key)];
+  return index == kEmpty ? nullptr : &voxels_[static_cast<std::size_t>(index)];
+}
+
+VoxelMap::Voxel& VoxelMap::findOrAdd(const VoxelKey& key) {
+  std::size_t slot = slotOf(key);
+  if (table_[slot] != kEmpty) return voxels_[static_cast<std::size_t>(table_[slot])];
+  if (2 * (voxels_.size() + 1) > table_.size()) {
+    rehash(table_.size() * 2);
+    slot = slotOf(key);
+  }
+  table_[slot] = static_cast<std::int32_t>(voxels_.size());
+  voxels_.push_back({key, {}});
+  return voxels_.back();
+}
+
+void VoxelMap::rehash(std::size_t slots) {
+  table_.assign(slots, kEmpty);
+  for (std::size_t v = 0; v < voxels_.size(); ++v) table_[slotOf(voxels_[v].key)] = static_cast<std::int32_t>(v);
+}
+
+// Linear probing's deletion without tombstones: later entries of the probe run move back into the gap when
+// their home slot does not lie between the gap and themselves.
+void VoxelMap::eraseSlot(std::size_t slot) {
+  const std::size_t mask = table_.size() - 1;
+  table_[slot] = kEmpty;
+  for (std::size_t next = (slot + 1) & mask; table_[next] != kEmpty; next = (next + 1) & mask) {
+    const std::size_t home = mixedHash(voxels_[static_cast<std::size_t>(table_[next])].key) & mask;
+    const bool stays = slot <= next ? (slot < home && home <= next) : (slot < home || home <= next);
+    if (stays) continue;
+    table_[slot] = table_[next];
+    table_[next] = kEmpty;
+    slot = next;
+  }
+}
 
 void VoxelMap::insert(const std::vector<Eigen::Vector3d>& points) {
   for (const Eigen::Vector3d& p : points) {
     if (!p.allFinite()) continue;
-    auto& cell = voxels_[voxelOf(p, voxel_size_)];
+    auto& cell = findOrAdd(voxelOf(p, voxel_size_)).points;
     if (static_cast<int>(cell.size()) >= max_points_per_voxel_) continue;
     const bool crowded = std::any_of(cell.begin(), cell.end(),
                                      [&](const Eigen::Vector3d& o) { return (o - p).squaredNorm() < min_spacing_sq_; });
@@ -25,15 +83,22 @@ void VoxelMap::insert(const std::vector<Eigen::Vector3d>& points) {
 
 void VoxelMap::removeFarFrom(const Eigen::Vector3d& centre, double radius) {
   const double r_sq = radius * radius;
-  for (auto it = voxels_.begin(); it != voxels_.end();) {
-    const Eigen::Vector3d c((it->first.x + 0.5) * voxel_size_, (it->first.y + 0.5) * voxel_size_,
-                            (it->first.z + 0.5) * voxel_size_);
-    if ((c - centre).squaredNorm() > r_sq) {
-      num_points_ -= it->second.size();
-      it = voxels_.erase(it);
-    } else {
-      ++it;
+  for (std::size_t v = 0; v < voxels_.size();) {
+    const VoxelKey& k = voxels_[v].key;
+    const Eigen::Vector3d c((k.x + 0.5) * voxel_size_, (k.y + 0.5) * voxel_size_, (k.z + 0.5) * voxel_size_);
+    if (!((c - centre).squaredNorm() > r_sq)) {
+      ++v;
+      continue;
     }
+    // The last voxel takes this one's place in the array (and in its table slot); v is looked at again.
+    num_points_ -= voxels_[v].points.size();
+    eraseSlot(slotOf(k));
+    const std::size_t last = voxels_.size() - 1;
+    if (v != last) {
+      voxels_[v] = std::move(voxels_[last]);
+      table_[slotOf(voxels_[v].key)] = static_cast<std::int32_t>(v);
+    }
+    voxels_.pop_back();
   }
 }
 
@@ -41,6 +106,7 @@ void VoxelMap::transform(const Eigen::Isometry3d& T) {
   std::vector<Eigen::Vector3d> moved = points();
   for (Eigen::Vector3d& p : moved) p = T * p;
   voxels_.clear();
+  table_.assign(kInitialSlots, kEmpty);
   num_points_ = 0;
   insert(moved);
 }
@@ -85,9 +151,9 @@ void VoxelMap::nearest(const Eigen::Vector3d& q, int k, double max_distance, std
     for (int dy : order[1])
       for (int dz : order[2]) {
         if (face_sq(0, dx) + face_sq(1, dy) + face_sq(2, dz) >= bound()) continue;
-        const auto it = voxels_.find({c.x + dx, c.y + dy, c.z + dz});
-        if (it == voxels_.end()) continue;
-        for (const Eigen::Vector3d& p : it->second) {
+        const Voxel* voxel = find({c.x + dx, c.y + dy, c.z + dz});
+        if (!voxel) continue;
+        for (const Eigen::Vector3d& p : voxel->points) {
           const double sq = (p - q).squaredNorm();
           if (!(sq < bound())) continue;
           // Insertion keeps the order stable for equal distances (first found wins): deterministic.
@@ -101,11 +167,13 @@ void VoxelMap::nearest(const Eigen::Vector3d& q, int k, double max_distance, std
 }
 
 std::vector<Eigen::Vector3d> VoxelMap::points() const {
-  std::map<VoxelKey, const std::vector<Eigen::Vector3d>*> sorted;
-  for (const auto& kv : voxels_) sorted.emplace(kv.first, &kv.second);
+  std::vector<const Voxel*> sorted;
+  sorted.reserve(voxels_.size());
+  for (const Voxel& v : voxels_) sorted.push_back(&v);
+  std::sort(sorted.begin(), sorted.end(), [](const Voxel* a, const Voxel* b) { return a->key < b->key; });
   std::vector<Eigen::Vector3d> out;
   out.reserve(num_points_);
-  for (const auto& kv : sorted) out.insert(out.end(), kv.second->begin(), kv.second->end());
+  for (const Voxel* v : sorted) out.insert(out.end(), v->points.begin(), v->points.end());
   return out;
 }
 

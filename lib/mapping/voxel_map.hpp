@@ -4,13 +4,17 @@
 // Determinism: results never depend on hash iteration order. Queries are lookups of the 27 voxels around a
 // point, each voxel's points kept in insertion order; removal erases a set that does not depend on order;
 // whole-map listings are sorted by voxel key.
+//
+// The voxels are a dense array found through an open-addressing table (linear probing, power-of-two size, at
+// most half full): a query looks up to 27 voxels, and std::unordered_map's prime modulo and node chains made
+// those lookups a quarter of the mapper's search time.
 #pragma once
 
 #include "mapping/voxel_key.hpp"
 
 #include <Eigen/Geometry>
 
-#include <unordered_map>
+#include <cstdint>
 #include <vector>
 
 namespace adit {
@@ -39,10 +43,23 @@ class VoxelMap {
   double voxelSize() const { return voxel_size_; }
 
  private:
+  struct Voxel {
+    VoxelKey key;
+    std::vector<Eigen::Vector3d> points;  // insertion order
+  };
+  static constexpr std::int32_t kEmpty = -1;
+
+  const Voxel* find(const VoxelKey& key) const;
+  Voxel& findOrAdd(const VoxelKey& key);
+  std::size_t slotOf(const VoxelKey& key) const;  // the key's slot, or the empty slot where it would go
+  void eraseSlot(std::size_t slot);
+  void rehash(std::size_t slots);
+
   double voxel_size_, min_spacing_sq_;
   int max_points_per_voxel_;
   std::size_t num_points_ = 0;
-  std::unordered_map<VoxelKey, std::vector<Eigen::Vector3d>, VoxelKeyHash> voxels_;
+  std::vector<Voxel> voxels_;         // dense, any order
+  std::vector<std::int32_t> table_;   // slot -> index into voxels_, or kEmpty
 };
 
 }  // namespace adit
