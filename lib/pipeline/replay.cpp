@@ -7,6 +7,7 @@
 #include "msg/type_name.hpp"
 #include "nodes/products.hpp"
 #include "nodes/registry.hpp"
+#include "runtime/allocator.hpp"
 #include "runtime/lcm_log.hpp"
 #include "runtime/pipelined_bus.hpp"
 #include "runtime/process.hpp"
@@ -203,6 +204,9 @@ ReplayReport runReplay(const ReplayOptions& options) {
   bus.finish();
   stopOnWriteError();
   output.close();
+  // The sweeps' freed buffers, kept for reuse while sweeps came (runtime/allocator.hpp), in every thread's
+  // arena: handed back before the products are built, whose map is the run's memory peak.
+  runtime::returnFreeMemory();
   if (options.on_progress) options.on_progress(1.0);
 
   report.corrupt_frames = input.corruptFrames();
