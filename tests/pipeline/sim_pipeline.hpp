@@ -3,6 +3,7 @@
 #pragma once
 
 #include "core/geometry.hpp"
+#include "eval/loop_recall.hpp"
 #include "eval/trajectory_io.hpp"
 #include "loop/loop_closer.hpp"
 #include "msg/convert.hpp"
@@ -26,6 +27,7 @@ struct SimPipelineRun {
   Trajectory scan_odometry;  // ODOM_SCAN: scan-to-scan odometry alone (SimPipelineSetup::scan_odometry)
   std::map<std::string, std::int64_t> odometry_counters;  // the odometry stage's STATUS counters at the end
   std::vector<LoopConstraint> loops;
+  std::vector<eval::JudgedLoop> judged_loops;  // the same loops, each judged against the truth
   int false_loops = 0;
   double worst_loop_error_m = 0, worst_loop_error_deg = 0;
 };
@@ -94,7 +96,9 @@ inline SimPipelineRun runSimPipeline(const std::string& world, double duration_s
     const double metres = measuredPart(loop, error.translation()).norm(), degrees = rotationAngle(error) * 180.0 / M_PI;
     run.worst_loop_error_m = std::max(run.worst_loop_error_m, metres);
     run.worst_loop_error_deg = std::max(run.worst_loop_error_deg, degrees);
-    if (metres > kFalseLoopMetres || degrees > kFalseLoopDegrees) ++run.false_loops;
+    const bool wrong = metres > kFalseLoopMetres || degrees > kFalseLoopDegrees;
+    if (wrong) ++run.false_loops;
+    run.judged_loops.push_back({loop.query_utime, !wrong});
   }
   fs::remove_all(options.out_dir);
   return run;
