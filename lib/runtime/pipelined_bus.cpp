@@ -36,11 +36,13 @@ class PipelinedBus::Collector : public Sink {
   std::vector<Message>& out_;
 };
 
+// Without finish() (the caller stopped on an error): what the worker has not started is abandoned.
 PipelinedBus::~PipelinedBus() {
   if (!worker_.joinable()) return;
   {
     std::lock_guard<std::mutex> lock(mutex_);
     closed_ = true;
+    batches_.clear();
   }
   changed_.notify_all();
   worker_.join();
