@@ -2,11 +2,13 @@
 // corrections move the map and future poses, deterministic global map output.
 #include "core/geometry.hpp"
 #include "mapping/scan_to_map.hpp"
+#include "mapping/voxel_map.hpp"
 #include "odometry/scan_to_scan.hpp"
 #include "synthetic_world.hpp"
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
@@ -173,3 +175,40 @@ TEST(GlobalMap, DroppedWhenAnotherStageOwnsTheMap) {
 
 }  // namespace
 }  // namespace adit
+
+// The local map's voxel table (open addressing with backward-shift deletion) against a brute-force search:
+// random points inserted and far voxels removed around a moving centre, many times over, so that removal runs
+// through collision chains and wraps around the table; every query's k nearest must be the brute-force ones.
+TEST(VoxelMap, QueriesMatchABruteForceSearchThroughInsertionsAndRemovals) {
+  adit::VoxelMap map(1.0, 0.05, 20);
+  std::uint64_t state = 12345;
+  const auto uniform = [&state](double lo, double hi) {
+    state = state * 6364136223846793005ULL + 1442695040888963407ULL;
+    return lo + (hi - lo) * static_cast<double>(state >> 11) / static_cast<double>(1ULL << 53);
+  };
+  for (int step = 0; step < 60; ++step) {
+    const Eigen::Vector3d centre(step * 2.0, 0.0, 0.0);
+    std::vector<Eigen::Vector3d> points;
+    for (int i = 0; i < 400; ++i)
+      points.emplace_back(centre.x() + uniform(-12, 12), uniform(-6, 6), uniform(-3, 3));
+    map.insert(points);
+    map.removeFarFrom(centre, 10.0);
+    const std::vector<Eigen::Vector3d> all = map.points();
+    ASSERT_EQ(all.size(), map.numPoints());
+    for (const Eigen::Vector3d& p : all) {  // nothing beyond the radius survives (voxel centres within 10 m)
+      const Eigen::Vector3d c = (p.array() / 1.0).floor().matrix() + Eigen::Vector3d::Constant(0.5);
+      ASSERT_LE((c - centre).norm(), 10.0 + 1e-9);
+    }
+    for (int q = 0; q < 50; ++q) {
+      const Eigen::Vector3d query(centre.x() + uniform(-8, 8), uniform(-5, 5), uniform(-2.5, 2.5));
+      std::vector<double> brute;
+      for (const Eigen::Vector3d& p : all)
+        if ((p - query).norm() < 1.0) brute.push_back((p - query).squaredNorm());
+      std::sort(brute.begin(), brute.end());
+      brute.resize(std::min<std::size_t>(brute.size(), 5));
+      const std::vector<Eigen::Vector3d> found = map.nearest(query, 5, 1.0);
+      ASSERT_EQ(found.size(), brute.size()) << "step " << step;
+      for (std::size_t i = 0; i < found.size(); ++i) ASSERT_DOUBLE_EQ((found[i] - query).squaredNorm(), brute[i]);
+    }
+  }
+}
