@@ -129,25 +129,25 @@ void PipelinedBus::workerLoop() {
   }
 }
 
-void PipelinedBus::notify(const Message& m) {
+void PipelinedBus::notify(const Message& m) const {
   for (auto& observer : observers_) observer(m.channel, *m.data, m.utime);
 }
 
 // The one-threaded bus's order over both groups: first in, first out; a message's upstream deliveries come
 // first (upstream nodes precede downstream ones), their publications taken from the trace.
 void PipelinedBus::replay(const Trace& trace) {
-  std::deque<std::pair<Message, bool>> queue;  // message, whether it is one the upstream group delivered
+  Queue queue;
   for (const Message& m : trace.roots) {
     if (trace.observe_roots) notify(m);
     queue.emplace_back(m, true);
   }
-  std::size_t next_pop = 0;
-  drainDownstream(queue, &trace, next_pop);
-  if (next_pop != trace.published.size()) throw std::logic_error("PipelinedBus: upstream trace out of step");
+  if (drainDownstream(queue, &trace) != trace.published.size())
+    throw std::logic_error("PipelinedBus: upstream trace out of step");
 }
 
-void PipelinedBus::drainDownstream(std::deque<std::pair<Message, bool>>& queue, const Trace* trace,
-                                   std::size_t& next_pop) {
+// Returns how many of the trace's records (one per upstream message delivered) it used.
+std::size_t PipelinedBus::drainDownstream(Queue& queue, const Trace* trace) {
+  std::size_t next_pop = 0;
   std::vector<Message> published;
   Collector sink(published);
   while (!queue.empty()) {
@@ -165,20 +165,22 @@ void PipelinedBus::drainDownstream(std::deque<std::pair<Message, bool>>& queue, 
       if (!nodes_[i]->isInput(m.channel)) continue;
       published.clear();
       nodes_[i]->deliver(m.channel, m.data->data(), m.data->size(), sink);
-      for (const Message& p : published) {
-        checkNotUpstream(p.channel);
-        notify(p);
-        queue.emplace_back(p, false);
-      }
+      queueDownstream(published, queue);
     }
   }
+  return next_pop;
 }
 
-// The cut is made from the advertised ports; a publication on any other port must not break it either.
-void PipelinedBus::checkNotUpstream(const std::string& channel) const {
-  for (std::size_t u = 0; u < split_; ++u)
-    if (nodes_[u]->isInput(channel))
-      throw std::logic_error("PipelinedBus: " + channel + " flows back to " + nodes_[u]->name());
+// What a downstream node published: observed and queued for delivery. The cut is made from the advertised
+// ports; a publication on any other port must not break it either.
+void PipelinedBus::queueDownstream(const std::vector<Message>& published, Queue& queue) const {
+  for (const Message& p : published) {
+    for (std::size_t u = 0; u < split_; ++u)
+      if (nodes_[u]->isInput(p.channel))
+        throw std::logic_error("PipelinedBus: " + p.channel + " flows back to " + nodes_[u]->name());
+    notify(p);
+    queue.emplace_back(p, false);
+  }
 }
 
 void PipelinedBus::finish() {
@@ -206,14 +208,9 @@ void PipelinedBus::finishDownstream() {
     std::vector<Message> published;
     Collector sink(published);
     nodes_[i]->finish(sink);
-    std::deque<std::pair<Message, bool>> queue;
-    for (const Message& p : published) {
-      checkNotUpstream(p.channel);
-      notify(p);
-      queue.emplace_back(p, false);
-    }
-    std::size_t next_pop = 0;
-    drainDownstream(queue, nullptr, next_pop);
+    Queue queue;
+    queueDownstream(published, queue);
+    drainDownstream(queue, nullptr);
   }
 }
 

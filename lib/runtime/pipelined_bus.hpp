@@ -65,6 +65,7 @@ class PipelinedBus {
     std::vector<std::vector<Message>> published;
   };
   class Collector;
+  using Queue = std::deque<std::pair<Message, bool>>;  // a message, and whether the upstream group delivered it
 
   void start();
   Trace runUpstream(std::vector<Message> roots, bool observe_roots);
@@ -72,9 +73,9 @@ class PipelinedBus {
   void workerLoop();
   void replay(const Trace& trace);
   void finishDownstream();
-  void drainDownstream(std::deque<std::pair<Message, bool>>& queue, const Trace* trace, std::size_t& next_pop);
-  void checkNotUpstream(const std::string& channel) const;
-  void notify(const Message& m);
+  std::size_t drainDownstream(Queue& queue, const Trace* trace);
+  void queueDownstream(const std::vector<Message>& published, Queue& queue) const;
+  void notify(const Message& m) const;
   void rethrow();
 
   bool pipelined_;
