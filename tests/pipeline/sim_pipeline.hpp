@@ -26,6 +26,7 @@ struct SimPipelineRun {
   Trajectory ground_truth, odometry, corrected;
   Trajectory scan_odometry;  // ODOM_SCAN: scan-to-scan odometry alone (SimPipelineSetup::scan_odometry)
   std::map<std::string, std::int64_t> odometry_counters;  // the odometry stage's STATUS counters at the end
+  std::map<std::string, std::int64_t> loop_counters;      // the loop closer's
   std::vector<LoopConstraint> loops;
   std::vector<eval::JudgedLoop> judged_loops;  // the same loops, each judged against the truth
   int false_loops = 0;
@@ -72,6 +73,7 @@ inline SimPipelineRun runSimPipeline(const std::string& world, double duration_s
   SimPipelineRun run;
   for (const auto& stage : report.timing)
     if (stage.stage == "odometry") run.odometry_counters = stage.counters;
+    else if (stage.stage == "loop_closer") run.loop_counters = stage.counters;
   run.ground_truth = source.groundTruth();
   run.odometry = eval::readTum(options.out_dir + "/odometry.tum");
   run.corrected = eval::readTum(options.out_dir + "/trajectory.tum");
