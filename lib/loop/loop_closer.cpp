@@ -77,7 +77,7 @@ std::size_t LoopCloser::jobsInFlight() const { return scheduler_ ? scheduler_->i
 double LoopCloser::waitedMs() const { return scheduler_ ? scheduler_->waitedMs() : 0.0; }
 
 LoopCloser::Result LoopCloser::process(const PoseEstimate& mapped, const LidarScan& cloud,
-                                       const std::vector<Eigen::Vector3f>* /*keypoints*/) {
+                                       const KeyframeKeypoints* keypoints) {
   Result result;
   ++stats_.sweeps;
   const bool out_of_order = !keyframes_.empty() && mapped.utime <= keyframes_.back().utime;
@@ -87,15 +87,16 @@ LoopCloser::Result LoopCloser::process(const PoseEstimate& mapped, const LidarSc
     if (config_.use_mapper_covariance && isValidCovariance(mapped.covariance) && !isUnsetCovariance(mapped.covariance))
       sweeps_since_keyframe_.emplace_back(mapped.pose, mapped.covariance);
     if (isKeyframe(mapped.pose)) {
-      const ScanContext context = addKeyframe(mapped, cloud);
+      const ScanContext context = addKeyframe(mapped, cloud, keypoints);
       const int k = static_cast<int>(keyframes_.size()) - 1;
       const bool revisit = isRevisit(k);
       // Empty contexts never match: a revisit keyframe is not a place later queries can find.
       database_.add(revisit ? ScanContext() : context, mapped.utime);
       result.keyframe_added = true;
-      submitJob(k, context);  // the job keeps its own copy of the cloud
+      submitJob(k, context);  // the job keeps its own copy of the cloud and keypoints
       if (revisit) {
         clouds_.drop(k);
+        keypoints_[static_cast<std::size_t>(k)].reset();
         ++stats_.revisit_keyframes;
       }
     }
@@ -135,6 +136,7 @@ void LoopCloser::submitJob(int query, const ScanContext& context) {
          j <= std::min(newest_allowed, m + config_.verifier.submap_neighbors); ++j) {
       snap.neighbourhood.clouds.push_back(clouds_.cloud(j));
       snap.neighbourhood.T_match_cloud.push_back(T_m_world * graph_.pose(j));
+      if (config_.keypoints.use) snap.neighbourhood_keypoints.push_back(keypoints_[static_cast<std::size_t>(j)]);
     }
     job.candidates.push_back(std::move(snap));
   }
@@ -146,6 +148,7 @@ void LoopCloser::submitJob(int query, const ScanContext& context) {
   job.query_utime = q.utime;
   job.query_uncorrected = q.uncorrected;
   job.query_cloud = clouds_.cloud(query);
+  if (config_.keypoints.use) job.query_keypoints = keypoints_[static_cast<std::size_t>(query)];
   job.graph = graph_;
   job.chain = chain_;
   job.applied_loops = accepted_.size();
@@ -167,6 +170,9 @@ void LoopCloser::applyDue(std::int64_t utime, bool all, Result& result) {
     stats_.rejected_pairwise += c.rejected_pairwise;
     stats_.accepted += c.accepted;
     stats_.partial_loops += c.partial_loops;
+    stats_.keypoint_seeds += c.keypoint_seeds;
+    stats_.keypoint_loops += c.keypoint_loops;
+    stats_.rejected_ambiguous += c.rejected_ambiguous;
     stats_.optimizations += c.optimizations;
     stats_.pending = c.pending;
     accepted_ = std::move(o.book.accepted);
@@ -229,7 +235,8 @@ bool LoopCloser::isRevisit(int keyframe) const {
 }
 
 // Adds the keyframe's cloud and graph node; returns its Scan Context (the caller adds it to the database).
-ScanContext LoopCloser::addKeyframe(const PoseEstimate& mapped, const LidarScan& cloud) {
+ScanContext LoopCloser::addKeyframe(const PoseEstimate& mapped, const LidarScan& cloud,
+                                    const KeyframeKeypoints* keypoints) {
   std::vector<Eigen::Vector3f> points;
   points.reserve(cloud.points.size());
   for (const LidarPoint& p : cloud.points)
@@ -254,8 +261,17 @@ ScanContext LoopCloser::addKeyframe(const PoseEstimate& mapped, const LidarScan&
   keyframes_.push_back(std::move(kf));
   clouds_.add(CompactCloud::encode(voxelDownsample(points, config_.keyframe_voxel),
                                    static_cast<float>(config_.keyframe_cloud_step)));
+  keypoints_.push_back(keypoints && config_.keypoints.use && !keypoints->empty()
+                           ? std::make_shared<const KeyframeKeypoints>(*keypoints)
+                           : nullptr);
   ++stats_.keyframes;
   return keyframeScanContext(std::move(points), mapped.pose, config_.level_scan_context, config_.scan_context);
+}
+
+const KeyframeKeypoints& LoopCloser::keyframeKeypoints(int k) const {
+  static const KeyframeKeypoints kNone;
+  const KeyframeKeypointsPtr& p = keypoints_[static_cast<std::size_t>(k)];
+  return p ? *p : kNone;
 }
 
 Eigen::Isometry3d LoopCloser::correction(int keyframe) const {

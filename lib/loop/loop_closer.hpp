@@ -17,6 +17,8 @@
 #include "core/config_table.hpp"
 #include "core/types.hpp"
 #include "loop/compact_cloud.hpp"
+#include "loop/keyframe_keypoints.hpp"
+#include "loop/keypoint_seed.hpp"
 #include "loop/keyframe_cloud_store.hpp"
 #include "loop/loop_verifier.hpp"
 #include "loop/odometry_chain.hpp"
@@ -71,6 +73,11 @@ struct LoopCloserConfig {
 
   // --- verification ---
   LoopVerifierConfig verifier;
+  // LinK3D keypoints (FEATURES) seed and check the verification (loop/keypoint_seed.hpp): their seed is tried
+  // when the Scan Context and graph seeds do not fit; when those fit and the keypoints put the query elsewhere,
+  // ICP runs from the keypoints' seed too: two accepted fits in different places that the odometry gate both
+  // allows are an aliased place, refused; if it allows one, that one is the loop.
+  KeypointSeedConfig keypoints;
   // A fit that pins every direction but one translation (the axis of a smooth straight roadway) joins the graph
   // as a partial loop: its covariance along that axis is partial_loop_axis_sigma, so it corrects the cross-
   // section, the height and the heading where a full loop would be refused, and leaves the position along the
@@ -138,6 +145,10 @@ struct LoopCloserStats {
   int partial_loops = 0;       // accepted loops that leave one translation free (partial_loops)
   int optimizations = 0;
   int revisit_keyframes = 0;   // keyframes that kept only their graph node (revisit_distance)
+  // LinK3D (loop.keypoints); like revisit_keyframes and partial_loops not in checkpoints (restart from 0).
+  int keypoint_seeds = 0;       // candidates whose keypoints gave a seed
+  int keypoint_loops = 0;       // verified fits that only the keypoints' seed found
+  int rejected_ambiguous = 0;   // two accepted fits in different places, both within the odometry gate
 };
 
 class LoopScheduler;
@@ -159,10 +170,9 @@ class LoopCloser {
   LoopCloser(LoopCloser&&) noexcept;
   LoopCloser& operator=(LoopCloser&&) noexcept;
 
-  // cloud: deskewed sweep in the lidar frame at mapped.utime. keypoints are accepted for API compatibility with
-  // LinK3D seeding but not used yet.
-  Result process(const PoseEstimate& mapped, const LidarScan& cloud,
-                 const std::vector<Eigen::Vector3f>* keypoints = nullptr);
+  // cloud: deskewed sweep in the lidar frame at mapped.utime; keypoints: the sweep's LinK3D keypoints (FEATURES),
+  // if known: kept with a keyframe's cloud to seed and check verification (loop.keypoints).
+  Result process(const PoseEstimate& mapped, const LidarScan& cloud, const KeyframeKeypoints* keypoints = nullptr);
   // End of input: applies every job still in flight (waiting for the worker).
   Result finish();
   // Loop jobs posted but not applied yet, and the wall time (ms, measurement only) sweeps waited for them.
@@ -181,6 +191,8 @@ class LoopCloser {
   const std::vector<Keyframe>& keyframes() const { return keyframes_; }
   // Keyframe k's cloud (downsampled, lidar frame; empty for a revisit), from memory or the page file.
   CompactCloud keyframeCloud(int k) const { return clouds_.cloud(k); }
+  // Keyframe k's LinK3D keypoints (empty for a revisit or a sweep without them).
+  const KeyframeKeypoints& keyframeKeypoints(int k) const;
   // A live process's memory: all but the newest `resident` keyframe clouds go to a page file
   // (loop/keyframe_cloud_store.hpp). Throws std::runtime_error if the file cannot be created.
   void pageCloudsTo(const std::string& path, std::size_t resident) { clouds_.pageTo(path, resident); }
@@ -204,7 +216,7 @@ class LoopCloser {
 
  private:
   bool isKeyframe(const Eigen::Isometry3d& pose) const;
-  ScanContext addKeyframe(const PoseEstimate& mapped, const LidarScan& cloud);
+  ScanContext addKeyframe(const PoseEstimate& mapped, const LidarScan& cloud, const KeyframeKeypoints* keypoints);
   bool isRevisit(int keyframe) const;
   Matrix6d stepCovariance(const Eigen::Isometry3d& new_pose) const;
   void submitJob(int query, const ScanContext& context);
@@ -214,6 +226,7 @@ class LoopCloser {
   LoopCloserConfig config_;
   std::vector<Keyframe> keyframes_;
   KeyframeCloudStore clouds_;  // [k]: keyframe k's cloud
+  std::vector<KeyframeKeypointsPtr> keypoints_;  // [k]: keyframe k's LinK3D keypoints or null (dropped with its cloud)
   OdometryChain chain_;
   PoseGraph graph_;
   ScanContextDatabase database_;

@@ -38,6 +38,20 @@ ConfigTable<LoopVerifierConfig> verifierTable() {
   return t;
 }
 
+ConfigTable<KeypointSeedConfig> keypointTable() {
+  using P = KeypointSeedConfig;
+  ConfigTable<P> t("loop.keypoints");
+  t.add("use", &P::use, anyValue(), "", "seed and check verification with the keyframes' LinK3D keypoints (FEATURES)")
+   .add("bin_tolerance", &P::bin_tolerance, above(0), "m", "two descriptor bins agree when both are set and this close")
+   .add("min_score", &P::min_score, between(1, 180), "bins", "agreeing bins a keypoint match needs")
+   .add("inlier_threshold", &P::inlier_threshold, above(0), "m", "a matched keypoint pair agrees with a transform within this distance")
+   .add("min_inliers", &P::min_inliers, between(3, 10000), "keypoints", "query keypoints that must agree for a seed")
+   .add("ransac_iterations", &P::ransac_iterations, between(1, 100000), "", "3-point hypotheses tried")
+   .add("agree_translation", &P::agree_translation, above(0), "m", "a seed or fit this close to another is the same alignment")
+   .add("agree_rotation_deg", &P::agree_rotation_deg, above(0), "deg", "same for rotation");
+  return t;
+}
+
 ConfigTable<PoseGraphConfig> graphTable() {
   using G = PoseGraphConfig;
   ConfigTable<G> t("loop.graph");
@@ -69,6 +83,7 @@ const ConfigTable<LoopCloserConfig>& loopCloserConfigTable() {
      .add("apply_delay_s", &K::apply_delay_s, between(0, 3600), "s", "a loop job's outcome is applied at the first sweep this much later (0: same sweep)")
      .add("worker_thread", &K::worker_thread, anyValue(), "", "verify and optimise on a worker thread (same results either way)")
      .nest(&K::verifier, verifierTable())
+     .nest(&K::keypoints, keypointTable())
      .add("partial_loops", &K::partial_loops, anyValue(), "", "a fit free along one translation only joins the graph as a partial loop")
      .add("partial_loop_axis_sigma", &K::partial_loop_axis_sigma, above(1), "m", "a partial loop's standard deviation along its free axis")
      .add("partial_loop_max_axis_offset", &K::partial_loop_max_axis_offset, above(0), "m", "the graph must put a partial loop's keyframes this close along its free axis")

@@ -67,6 +67,7 @@ std::string LoopCloser::keyframeRecord(int k) const {
   putCompactCloud(w, clouds_.cloud(k));
   putScanContext(w, database_.context(k));
   w.putMatrix(chain_.stepCovariance(k));
+  keyframeKeypoints(k).put(w);  // last: records written before it have none
   return w.bytes();
 }
 
@@ -116,12 +117,16 @@ bool LoopCloser::restoreState(const std::string& state, const std::vector<std::s
     std::optional<ScanContext> context = cloud ? getScanContext(kr) : std::nullopt;
     if (!context) return false;
     const Matrix6d step = kr.getMatrix<Matrix6d>();
-    if (!kr.ok() || !kr.atEnd()) return false;
+    std::optional<KeyframeKeypoints> keypoints = KeyframeKeypoints();
+    if (kr.ok() && !kr.atEnd()) keypoints = KeyframeKeypoints::get(kr);
+    if (!kr.ok() || !kr.atEnd() || !keypoints) return false;
     restored.chain_.add(kf.uncorrected, step);
     restored.graph_.addNode(r.getPose());
     restored.database_.add(*context, kf.utime);
     restored.keyframes_.push_back(std::move(kf));
     restored.clouds_.add(std::move(*cloud));
+    restored.keypoints_.push_back(keypoints->empty() ? nullptr
+                                                     : std::make_shared<const KeyframeKeypoints>(std::move(*keypoints)));
   }
   const auto edges = r.getCount(4 + 4 + 96 + 288 + 1);
   for (std::uint64_t i = 0; i < edges && r.ok(); ++i) {

@@ -47,24 +47,41 @@ class JobRun {
   }
 
   std::optional<LoopConstraint> verify(const LoopCandidateSnapshot& c) {
-    // Seeds: the Scan Context yaw, then the graph's current relative pose. The clouds are decoded here, on the
-    // worker: the main thread only copies the compact clouds into the job.
+    // Seeds: the Scan Context yaw, then the graph's current relative pose (then LinK3D's, see verification()).
     const int m = c.candidate.index;
     const Eigen::Isometry3d T_graph = job_.graph.pose(m).inverse() * job_.graph.pose(job_.query);
     const std::vector<Eigen::Isometry3d> seeds{
         scanContextSeed(job_.query_uncorrected, c.match_uncorrected, c.candidate.yaw, config_.level_scan_context),
         T_graph};
-    const LoopVerification v = verifyCandidate(job_.query_cloud, c.neighbourhood, seeds, config_.verifier);
+    const std::vector<LoopVerification> fits = verification(c, seeds);
+    if (fits.size() == 1) {
+      const Judged j = judge(c, fits[0], T_graph);
+      if (j.rejection) ++*j.rejection;
+      return j.loop;
+    }
+    // Two accepted fits in different places (the keypoints' and the other seeds'): the odometry may tell them
+    // apart; if it allows both, the place is aliased and neither is trusted.
+    const Judged a = judge(c, fits[0], T_graph), b = judge(c, fits[1], T_graph);
+    if (a.loop && b.loop) {
+      ++counts_.rejected_ambiguous;
+      return std::nullopt;
+    }
+    if (!a.loop && !b.loop) ++counts_.rejected_odometry;
+    return a.loop ? a.loop : b.loop;
+  }
+
+  // A verified fit as a loop constraint, or the counter of why it is none.
+  struct Judged {
+    std::optional<LoopConstraint> loop;
+    int* rejection = nullptr;
+  };
+
+  Judged judge(const LoopCandidateSnapshot& c, const LoopVerification& v, const Eigen::Isometry3d& T_graph) {
+    const int m = c.candidate.index;
     const bool partial = v.verdict == LoopVerdict::kDegenerate && config_.partial_loops &&
                          pinsAllButOneTranslation(v.icp.observability, config_.verifier);
-    if (v.verdict == LoopVerdict::kDegenerate && !partial) {
-      ++counts_.rejected_degenerate;
-      return std::nullopt;
-    }
-    if (v.verdict != LoopVerdict::kAccepted && !partial) {
-      ++counts_.rejected_fitness;
-      return std::nullopt;
-    }
+    if (v.verdict == LoopVerdict::kDegenerate && !partial) return {std::nullopt, &counts_.rejected_degenerate};
+    if (v.verdict != LoopVerdict::kAccepted && !partial) return {std::nullopt, &counts_.rejected_fitness};
     Eigen::Isometry3d T_match_query = v.T_match_query;
     Matrix6d loop_cov = loopMeasurementCovariance(config_);
     if (partial) {
@@ -72,18 +89,13 @@ class JobRun {
       // T_match_query; loop residuals are in the query's.
       const Eigen::Vector3d axis = v.icp.observability.weakestTranslation().normalized();
       const double graph_along = axis.dot(T_graph.translation());
-      if (!(std::abs(graph_along) <= config_.partial_loop_max_axis_offset)) {
-        ++counts_.rejected_degenerate;
-        return std::nullopt;
-      }
+      if (!(std::abs(graph_along) <= config_.partial_loop_max_axis_offset))
+        return {std::nullopt, &counts_.rejected_degenerate};
       T_match_query.translation() += axis * (graph_along - axis.dot(T_match_query.translation()));
       loop_cov = partialLoopCovariance(config_, T_match_query.linear().transpose() * axis);
     }
     const double chi2 = loopChi2(T_match_query, T_graph, job_.chain.covarianceBetween(m, job_.query), loop_cov);
-    if (!(chi2 <= config_.max_odometry_chi2)) {
-      ++counts_.rejected_odometry;
-      return std::nullopt;
-    }
+    if (!(chi2 <= config_.max_odometry_chi2)) return {std::nullopt, &counts_.rejected_odometry};
     LoopConstraint loop;
     loop.query_index = job_.query;
     loop.match_index = m;
@@ -95,7 +107,39 @@ class JobRun {
     loop.scan_context_yaw = c.candidate.yaw;
     loop.fitness = v.icp.rms;
     loop.inlier_ratio = v.icp.inlier_ratio;
-    return loop;
+    return {loop, nullptr};
+  }
+
+  // ICP of the query against the candidate's submap from the seeds in order, then the LinK3D keypoints' say.
+  // Where no seed fits: ICP from the keypoints' seed. Where a seed gave an accepted fit and the keypoints put the
+  // query elsewhere: ICP from theirs as well; a second accepted fit away from the first is returned beside it
+  // (two fits: an aliased place unless the odometry rules one out). A keypoint seed whose ICP does not fit is
+  // outvoted by the geometry. A degenerate fit is left as it is (sliding along its free axis fits everywhere; a
+  // partial loop takes that axis from the graph). The clouds are decoded here, on the worker: the main thread
+  // only copies the compact clouds into the job.
+  std::vector<LoopVerification> verification(const LoopCandidateSnapshot& c, const std::vector<Eigen::Isometry3d>& seeds) {
+    const std::unique_ptr<PlaneTarget> target = candidateTarget(c.neighbourhood, config_.verifier);
+    const std::vector<Eigen::Vector3f> source = querySource(job_.query_cloud.decode(), config_.verifier);
+    const LoopVerification v = verifyLoopAgainst(*target, source, seeds, config_.verifier);
+    const KeypointSeedConfig& k = config_.keypoints;
+    if (!k.use || !job_.query_keypoints || v.verdict == LoopVerdict::kTooFewPoints ||
+        v.verdict == LoopVerdict::kDegenerate)
+      return {v};
+    const KeypointSeed seed =
+        keypointSeed(*job_.query_keypoints, c.neighbourhood_keypoints, c.neighbourhood.T_match_cloud, k);
+    if (!seed.ok) return {v};
+    ++counts_.keypoint_seeds;
+    const bool accepted = v.verdict == LoopVerdict::kAccepted;
+    if (accepted && posesAgree(v.T_match_query, seed.T_match_query, k)) return {v};
+    LoopVerification w = verifyLoopAgainst(*target, source, {seed.T_match_query}, config_.verifier);
+    w.seed = static_cast<int>(seeds.size());
+    if (!accepted) {
+      const bool found = w.verdict == LoopVerdict::kAccepted || w.verdict == LoopVerdict::kDegenerate;
+      if (found) ++counts_.keypoint_loops;
+      return {found ? w : v};
+    }
+    if (w.verdict != LoopVerdict::kAccepted || posesAgree(v.T_match_query, w.T_match_query, k)) return {v};
+    return {v, w};
   }
 
   bool pairConsistent(const LoopConstraint& a, const LoopConstraint& b) const {

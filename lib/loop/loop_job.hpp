@@ -33,6 +33,7 @@ struct LoopCandidateSnapshot {
   std::int64_t match_utime = 0;
   Eigen::Isometry3d match_uncorrected = Eigen::Isometry3d::Identity();
   CandidateNeighbourhood neighbourhood;  // the candidate's neighbours, each at its graph pose relative to it
+  std::vector<KeyframeKeypointsPtr> neighbourhood_keypoints;  // [i]: neighbourhood.clouds[i]'s (loop.keypoints.use)
 };
 
 struct LoopJob {
@@ -40,6 +41,7 @@ struct LoopJob {
   std::int64_t query_utime = 0;
   Eigen::Isometry3d query_uncorrected = Eigen::Isometry3d::Identity();
   CompactCloud query_cloud;
+  KeyframeKeypointsPtr query_keypoints;  // null: none
   std::vector<LoopCandidateSnapshot> candidates;  // best first, at most max_verifications, under the threshold
   PoseGraph graph;      // nodes 0..query with the loop edges the main thread has applied
   OdometryChain chain;  // keyframes 0..query

@@ -167,6 +167,21 @@ adit::features_t toMessage(const FeatureSet& f) {
   return m;
 }
 
+void keypointsOf(const adit::features_t& m, std::vector<Eigen::Vector3f>& keypoints,
+                 std::vector<LinK3dDescriptor>& descriptors) {
+  keypoints.clear();
+  descriptors.clear();
+  // A descriptor of another size cannot be compared with ours: keep the keypoints only if sizes agree.
+  if (m.descriptor_size != kLinK3dBins || !(m.descriptor_scale > 0.0f) || !std::isfinite(m.descriptor_scale)) return;
+  for (int i = 0; i < m.num_keypoints; ++i) {
+    keypoints.emplace_back(m.keypoints[i][0], m.keypoints[i][1], m.keypoints[i][2]);
+    LinK3dDescriptor d{};
+    for (int b = 0; b < kLinK3dBins; ++b)
+      d[static_cast<std::size_t>(b)] = static_cast<float>(m.descriptors[i][static_cast<std::size_t>(b)]) * m.descriptor_scale;
+    descriptors.push_back(d);
+  }
+}
+
 FeatureSet fromMessage(const adit::features_t& m) {
   FeatureSet f;
   f.utime = m.header.utime;
@@ -181,16 +196,7 @@ FeatureSet fromMessage(const adit::features_t& m) {
   f.corner_less_sharp = fromPointSet(m.corner_less_sharp);
   f.surf_flat = fromPointSet(m.surf_flat);
   f.surf_less_flat = fromPointSet(m.surf_less_flat);
-  // A descriptor of another size cannot be compared with ours: keep the keypoints only if sizes agree.
-  if (m.descriptor_size == kLinK3dBins && m.descriptor_scale > 0.0f && std::isfinite(m.descriptor_scale)) {
-    for (int i = 0; i < m.num_keypoints; ++i) {
-      f.keypoints.emplace_back(m.keypoints[i][0], m.keypoints[i][1], m.keypoints[i][2]);
-      LinK3dDescriptor d{};
-      for (int b = 0; b < kLinK3dBins; ++b)
-        d[static_cast<std::size_t>(b)] = static_cast<float>(m.descriptors[i][static_cast<std::size_t>(b)]) * m.descriptor_scale;
-      f.descriptors.push_back(d);
-    }
-  }
+  keypointsOf(m, f.keypoints, f.descriptors);
   f.flags = m.flags;
   f.points_in = m.points_in;
   f.removed_invalid = m.removed_invalid;

@@ -35,6 +35,9 @@ constexpr float kDescriptorScale = 0.002f;
 // caller thins it first), keypoints and descriptors. fromMessage gives cloud.points without rings.
 adit::features_t toMessage(const FeatureSet& features);
 FeatureSet fromMessage(const adit::features_t& msg);
+// Only the LinK3D keypoints and descriptors (none when the descriptor's size or scale is not ours).
+void keypointsOf(const adit::features_t& msg, std::vector<Eigen::Vector3f>& keypoints,
+                 std::vector<LinK3dDescriptor>& descriptors);
 
 // ODOM_SCAN / ODOM_MAPPED: features may be nullptr (GROUND_TRUTH): no points. Otherwise the message carries
 // features->corner_less_sharp, surf_less_flat and cloud.points (whatever of them the caller left non-empty).

@@ -17,11 +17,13 @@
 #include "runtime/record_log.hpp"
 
 #include <adit/command_t.hpp>
+#include <adit/features_t.hpp>
 #include <adit/map_update_t.hpp>
 #include <adit/pose_graph_t.hpp>
 #include <spdlog/spdlog.h>
 
 #include <atomic>
+#include <deque>
 #include <memory>
 
 namespace adit::nodes {
@@ -40,6 +42,9 @@ class LoopCloserNode : public runtime::Node, public WritesProducts, public Write
         updates_(mapUpdateConfigFrom(config)), config_keys_(pipelineConfigKeys(config)),
         reloc_(relocNodeConfigTable().read(config)), state_("loop_closer") {
     subscribe<adit::odometry_t>("mapped", "ODOM_MAPPED", [this](const adit::odometry_t& m) { onMapped(m); });
+    // The sweeps' LinK3D keypoints, which seed and check loop verification (loop.keypoints.use).
+    if (closer_.config().keypoints.use)
+      subscribe<adit::features_t>("features", "FEATURES", [this](const adit::features_t& m) { onFeatures(m); });
     // Extending a saved map: the relocaliser's measured poses in it are what join this run's map to it.
     if (reloc_.extending())
       subscribe<adit::odometry_t>("pose_in_map", "POSE_IN_MAP", [this](const adit::odometry_t& m) { onPoseInMap(m); },
@@ -121,13 +126,32 @@ class LoopCloserNode : public runtime::Node, public WritesProducts, public Write
     if (measured.pose.matrix().allFinite()) anchors_.push_back({measured.utime, measured.pose});
   }
 
+  // A sweep's features precede its mapped pose (the mapper needs them first); a few are kept until it comes.
+  void onFeatures(const adit::features_t& m) {
+    std::vector<Eigen::Vector3f> points;
+    std::vector<LinK3dDescriptor> descriptors;
+    msg::keypointsOf(m, points, descriptors);
+    recent_keypoints_.emplace_back(m.header.utime, KeyframeKeypoints::encode(points, descriptors));
+    if (recent_keypoints_.size() > kRecentKeypoints) recent_keypoints_.pop_front();
+  }
+
+  // The keypoints of the sweep at utime, if its FEATURES came; older ones are dropped.
+  std::optional<KeyframeKeypoints> takeKeypoints(std::int64_t utime) {
+    while (!recent_keypoints_.empty() && recent_keypoints_.front().first < utime) recent_keypoints_.pop_front();
+    if (recent_keypoints_.empty() || recent_keypoints_.front().first != utime) return std::nullopt;
+    std::optional<KeyframeKeypoints> out = std::move(recent_keypoints_.front().second);
+    recent_keypoints_.pop_front();
+    return out;
+  }
+
   void onMapped(const adit::odometry_t& m) {
     PoseEstimate mapped = msg::fromMessage(m);
     // The graph is built on uncorrected poses: undo the correction the mapper had already applied.
     mapped.pose = makePose(m.loop_correction_position, m.loop_correction_orientation).inverse() * mapped.pose;
     const LidarScan cloud = msg::featuresOf(m).cloud;
     trajectory_.push_back({mapped.utime, mapped.pose});
-    const LoopCloser::Result result = closer_.process(mapped, cloud);
+    const std::optional<KeyframeKeypoints> keypoints = takeKeypoints(mapped.utime);
+    const LoopCloser::Result result = closer_.process(mapped, cloud, keypoints ? &*keypoints : nullptr);
     publishResult(mapped.utime, result);
     if (const auto update = updates_.update(mapped.utime, closer_)) publishMapUpdate(*update);
     const LoopCloserStats& s = closer_.stats();
@@ -143,6 +167,9 @@ class LoopCloserNode : public runtime::Node, public WritesProducts, public Write
     setCount("loop_candidates", s.candidates);
     setCount("loops_accepted", s.accepted);
     setCount("partial_loops", s.partial_loops);
+    setCount("keypoint_seeds", s.keypoint_seeds);
+    setCount("keypoint_loops", s.keypoint_loops);
+    setCount("rejected_ambiguous", s.rejected_ambiguous);
     setCount("rejected_fitness", s.rejected_fitness);
     setCount("rejected_degenerate", s.rejected_degenerate);
     setCount("rejected_odometry_gate", s.rejected_odometry);
@@ -322,6 +349,8 @@ class LoopCloserNode : public runtime::Node, public WritesProducts, public Write
   }
 
   LoopCloser closer_;
+  static constexpr std::size_t kRecentKeypoints = 16;
+  std::deque<std::pair<std::int64_t, KeyframeKeypoints>> recent_keypoints_;  // utime, keypoints
   LoopCloserNodeConfig node_;  // map voxel, checkpoint spacing, clouds kept in memory
   MapUpdateTracker updates_;
   std::map<std::string, std::string> config_keys_;  // every pipeline key, for the bundle's config.yaml
