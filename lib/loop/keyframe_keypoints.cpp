@@ -18,11 +18,10 @@ KeyframeKeypoints KeyframeKeypoints::encode(const std::vector<Eigen::Vector3f>& 
     if (!keypoints[i].allFinite()) continue;
     out.points_.push_back(keypoints[i]);
     for (int b = 0; b < kLinK3dBins; ++b) {
-      const float d = descriptors[i][static_cast<std::size_t>(b)];
-      const long cm = std::isfinite(d) ? std::lround(d / kCm) : 0;
-      if (cm <= 0) continue;  // empty, or closer than 5 mm: nothing a match could use
+      const float cm = descriptors[i][static_cast<std::size_t>(b)] / kCm;
+      if (!(cm >= 0.5f)) continue;  // empty, NaN, or closer than 5 mm: nothing a match could use
       out.bin_.push_back(static_cast<std::uint8_t>(b));
-      out.dist_.push_back(static_cast<std::uint16_t>(std::min(cm, 65535L)));
+      out.dist_.push_back(cm >= 65535.0f ? std::uint16_t{65535} : static_cast<std::uint16_t>(std::lround(cm)));
     }
     out.end_.push_back(static_cast<std::uint32_t>(out.bin_.size()));
   }

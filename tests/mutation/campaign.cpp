@@ -84,6 +84,7 @@ std::vector<Target> targets() {
       {"mapper", "ODOM_SCAN", "ODOM_SCAN (mapper)", typeOf<adit::odometry_t>(), false, "ODOM_MAPPED", 0.5},
       {"mapper", "POSE_GRAPH", "POSE_GRAPH", typeOf<adit::pose_graph_t>(), false, "ODOM_MAPPED", 0.5},
       {"loop_closer", "ODOM_MAPPED", "ODOM_MAPPED", typeOf<adit::odometry_t>(), false, "", 0},
+      {"loop_closer", "FEATURES", "FEATURES (loop closer: LinK3D keypoints)", typeOf<adit::features_t>(), false, "", 0},
       {"loop_closer", "MAPPER_COMMAND", "MAPPER_COMMAND", typeOf<adit::command_t>(), false, "", 0},
       // Relocalising in a saved map: the mapped poses it tracks and the operator's pose guesses. Its pose in
       // the map after the mutations: within the same bound (a fix refused is re-queried, never guessed).
