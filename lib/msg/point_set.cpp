@@ -6,18 +6,18 @@
 namespace adit::msg {
 namespace {
 
-// std::lround (half away from zero) without the libm call: truncate, then step when the remainder (exact in
-// float) reaches one half. The scale keeps |q| <= 32767 for the points that are written, so the
-// truncation cannot overflow; anything larger goes to lround as before.
-long roundHalfAway(float q) {
-  if (!(std::fabs(q) < 1e9f)) return std::lround(q);
-  const long t = static_cast<long>(q);
-  const float rest = q - static_cast<float>(t);
-  return rest >= 0.5f ? t + 1 : rest <= -0.5f ? t - 1 : t;
-}
-
-std::int16_t count(float v, float scale) {
-  return static_cast<std::int16_t>(std::clamp(roundHalfAway(v / scale), -32767L, 32767L));
+// The int16 count of each coordinate: v / scale rounded half away from zero, clamped to +-32767. Written without
+// branches or libm calls over a plain array so that the compiler vectorises it (it runs for every point of
+// every set each stage publishes). Clamping before rounding gives what rounding and then clamping gave: a
+// quotient beyond +-32767 lands on +-32767 either way. Callers pass finite coordinates only.
+void countsOf(const float* v, std::size_t n, float scale, std::int16_t* out) {
+  for (std::size_t i = 0; i < n; ++i) {
+    const float q = std::min(std::max(v[i] / scale, -32767.0f), 32767.0f);
+    const auto t = static_cast<std::int32_t>(q);  // truncation toward zero
+    const float rest = q - static_cast<float>(t);
+    out[i] = static_cast<std::int16_t>(t + static_cast<std::int32_t>(rest >= 0.5f) -
+                                       static_cast<std::int32_t>(rest <= -0.5f));
+  }
 }
 
 }  // namespace
@@ -48,11 +48,14 @@ adit::point_set_t toPointSet(const std::vector<LidarPoint>& points, PointSetFiel
   s.x.resize(n);
   s.y.resize(n);
   s.z.resize(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    s.x[i] = count(kept[i]->p.x(), s.scale);
-    s.y[i] = count(kept[i]->p.y(), s.scale);
-    s.z[i] = count(kept[i]->p.z(), s.scale);
-  }
+  std::vector<float> axis(n);
+  const auto quantise = [&](int a, std::vector<std::int16_t>& to) {
+    for (std::size_t i = 0; i < n; ++i) axis[i] = kept[i]->p[a];
+    countsOf(axis.data(), n, s.scale, to.data());
+  };
+  quantise(0, s.x);
+  quantise(1, s.y);
+  quantise(2, s.z);
   if (fields.rings) {
     s.num_rings = s.num_points;
     s.ring.resize(n);
