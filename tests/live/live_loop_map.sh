@@ -2,7 +2,8 @@
 # The corrected map of a live run (issue 12): the whole pipeline as real processes over UDP multicast in a
 # private network namespace, on a small simulated loop at real time. `adit command save_map before_loop`
 # is sent before the robot is back at its start; the clean stop saves the map after the loop closed.
-# Checks: the early save has no loop in its pose graph and the final one has; both maps lie on the
+# Checks: the early save has no loop in its pose graph and the final one has; the loop closer got the sweeps'
+# LinK3D keypoints (FEATURES) and seeded candidates with them; both maps lie on the
 # simulator's true surfaces (mean distance of map points to the nearest surface sample, share beyond
 # 0.2 m: a ghosted, duplicated roadway shows there) and both trajectories match the ground truth.
 #   live_loop_map.sh <bin_dir> <source_dir>   (tests/integration/netns.sh puts it in the namespace)
@@ -33,6 +34,10 @@ before=$(loops "$RUN/before_loop.g2o") after=$(loops "$RUN/pose_graph.g2o")
 [ "$before" = 0 ] && echo "ok: no loop in the graph saved before the revisit" ||
   { echo "FAIL: $before loops before the revisit"; failed=1; }
 [ "$after" -ge 1 ] && echo "ok: $after loops in the final graph" || { echo "FAIL: no loop closed"; failed=1; }
+# FEATURES reach the loop-closer process over the bus: its candidates were seeded by LinK3D keypoints.
+seeds=$(grep -E "^counters loop_closer" "$WORK/report.txt" | grep -oE "keypoint_seeds=[0-9]+" | cut -d= -f2)
+[ "${seeds:-0}" -ge 1 ] && echo "ok: $seeds loop candidates had a LinK3D keypoint seed" ||
+  { echo "FAIL: no LinK3D keypoint seed in the loop closer (keypoint_seeds=${seeds:-missing})"; failed=1; }
 check() {  # name map.pcd trajectory.tum
   local line mean far rmse
   line=$("$BIN/map_vs_world" "$2" "$WORK/world.pcd" "$WORK/gt.tum" "$3")
