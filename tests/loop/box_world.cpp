@@ -1,5 +1,6 @@
 #include "box_world.hpp"
 
+#include <array>
 #include <cmath>
 #include <limits>
 #include <random>
@@ -109,6 +110,25 @@ BoxWorld makeRoadway(std::uint32_t seed, double width, int features, bool cross_
       w.add(x, -h, 0, x + l, -h + d, z);
   }
   return w;
+}
+
+BoxWorld makePeriodicRoadway(std::uint32_t seed, double period, int boxes, double half_width, int first, int last) {
+  BoxWorld world;
+  world.addFloorAndRoof(-200, -10, 300, 10, 4.0);
+  world.add(-200, half_width, 0, 300, half_width + 2, 4);
+  world.add(-200, -half_width - 2, 0, 300, -half_width, 4);
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  std::vector<std::array<double, 4>> pattern;  // x in the period, length, depth, top
+  for (int i = 0; i < boxes; ++i) pattern.push_back({period * u(rng), 0.6 + 2 * u(rng), 0.4 + 0.8 * u(rng), 0.8 + 2.7 * u(rng)});
+  for (int k = first; k <= last; ++k)
+    for (std::size_t i = 0; i < pattern.size(); ++i) {
+      const auto& [x, len, d, z] = pattern[i];
+      const double x0 = x + period * k;
+      if (i % 2 == 0) world.add(x0, half_width - d, 0, x0 + len, half_width, z);
+      else world.add(x0, -half_width, 0, x0 + len, -half_width + d, z);
+    }
+  return world;
 }
 
 }  // namespace adit::testing

@@ -39,4 +39,9 @@ namespace adit::testing {
 BoxWorld makeRoadway(std::uint32_t seed, double width = 4.8, int features = 8, bool cross_cut = false,
                      double x0 = -60.0, double x1 = 60.0);
 
+// A straight roadway along x from -200 to 300 m, 2 * half_width wide and 4 m high, whose equipment (`boxes`
+// boxes against alternate walls, drawn from `seed`) repeats exactly every `period` metres, for the periods
+// first..last: a place one period on looks identical (aliasing).
+BoxWorld makePeriodicRoadway(std::uint32_t seed, double period, int boxes, double half_width, int first, int last);
+
 }  // namespace adit::testing

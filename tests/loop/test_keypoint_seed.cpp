@@ -193,21 +193,7 @@ TEST(KeypointSeed, RefusesAPlaceWhereKeypointsAndScanContextFindTwoFitsTheOdomet
   // the query's keypoints are moved one period along the roadway (what an aliased keypoint match gives), so
   // their seed puts the query 20 m further on, where it fits just as tightly. With the odometry uncertain by
   // 10 m between the visits both places pass its gate: no way to tell which is right, so no loop.
-  BoxWorld world;
-  world.addFloorAndRoof(-200, -10, 300, 10, 4.0);
-  world.add(-200, 4.0, 0, 300, 6.0, 4);
-  world.add(-200, -6.0, 0, 300, -4.0, 4);
-  std::mt19937 rng(9);
-  std::uniform_real_distribution<double> u(0.0, 1.0);
-  std::vector<std::array<double, 4>> pattern;
-  for (int i = 0; i < 10; ++i) pattern.push_back({20 * u(rng), 0.6 + 2 * u(rng), 0.4 + 0.8 * u(rng), 0.8 + 2.7 * u(rng)});
-  for (int period = -4; period < 6; ++period)  // x from -80 to 120 m: what the sweeps below see
-    for (std::size_t i = 0; i < pattern.size(); ++i) {
-      const auto& [x, len, d, z] = pattern[i];
-      const double x0 = x + 20.0 * period;
-      if (i % 2 == 0) world.add(x0, 4.0 - d, 0, x0 + len, 4.0, z);
-      else world.add(x0, -4.0, 0, x0 + len, -4.0 + d, z);
-    }
+  const BoxWorld world = adit::testing::makePeriodicRoadway(9, 20.0, 10, 4.0, -4, 5);  // x from -80 to 120 m
   const Eigen::Isometry3d match = poseXYYaw(0, 0, 1.8, 0);
   const Eigen::Isometry3d query = poseXYYaw(0.3, 0.5, 1.8, 3 * kDeg);
   const Sweep own = sweepAt(world, query, 7);

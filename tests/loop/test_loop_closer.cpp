@@ -245,21 +245,7 @@ TEST(LoopCloser, RevisitedKeyframesKeepOnlyTheirGraphNode) {
 
 TEST(LoopCloser, RejectsAPeriodicRoadway) {
   // A straight roadway whose equipment repeats exactly every 60 m: a place 60 m back looks identical.
-  BoxWorld world;
-  world.addFloorAndRoof(-200, -10, 300, 10, 4.0);
-  world.add(-200, 2.4, 0, 300, 4.4, 4);
-  world.add(-200, -4.4, 0, 300, -2.4, 4);
-  std::mt19937 rng(9);
-  std::uniform_real_distribution<double> u(0.0, 1.0);
-  std::vector<std::array<double, 4>> pattern;
-  for (int i = 0; i < 16; ++i) pattern.push_back({60 * u(rng), 0.6 + 2 * u(rng), 0.4 + 0.8 * u(rng), 0.8 + 2.7 * u(rng)});
-  for (int period = -3; period < 5; ++period)
-    for (std::size_t i = 0; i < pattern.size(); ++i) {
-      const auto& [x, len, d, z] = pattern[i];
-      const double x0 = x + 60.0 * period;
-      if (i % 2 == 0) world.add(x0, 2.4 - d, 0, x0 + len, 2.4, z);
-      else world.add(x0, -2.4, 0, x0 + len, -2.4 + d, z);
-    }
+  const BoxWorld world = adit::testing::makePeriodicRoadway(9, 60.0, 16, 2.4, -3, 4);
   std::vector<Eigen::Isometry3d> truth;
   for (int k = 0; k < 130; ++k) truth.push_back(poseXYYaw(k, 0.1 * std::sin(0.3 * k), 1.8, 0.0));
   Drive run;
