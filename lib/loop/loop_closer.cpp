@@ -77,7 +77,7 @@ std::size_t LoopCloser::jobsInFlight() const { return scheduler_ ? scheduler_->i
 double LoopCloser::waitedMs() const { return scheduler_ ? scheduler_->waitedMs() : 0.0; }
 
 LoopCloser::Result LoopCloser::process(const PoseEstimate& mapped, const LidarScan& cloud,
-                                       const KeyframeKeypoints* keypoints) {
+                                       KeyframeKeypointsPtr keypoints) {
   Result result;
   ++stats_.sweeps;
   const bool out_of_order = !keyframes_.empty() && mapped.utime <= keyframes_.back().utime;
@@ -87,7 +87,7 @@ LoopCloser::Result LoopCloser::process(const PoseEstimate& mapped, const LidarSc
     if (config_.use_mapper_covariance && isValidCovariance(mapped.covariance) && !isUnsetCovariance(mapped.covariance))
       sweeps_since_keyframe_.emplace_back(mapped.pose, mapped.covariance);
     if (isKeyframe(mapped.pose)) {
-      const ScanContext context = addKeyframe(mapped, cloud, keypoints);
+      const ScanContext context = addKeyframe(mapped, cloud, std::move(keypoints));
       const int k = static_cast<int>(keyframes_.size()) - 1;
       const bool revisit = isRevisit(k);
       // Empty contexts never match: a revisit keyframe is not a place later queries can find.
@@ -236,7 +236,7 @@ bool LoopCloser::isRevisit(int keyframe) const {
 
 // Adds the keyframe's cloud and graph node; returns its Scan Context (the caller adds it to the database).
 ScanContext LoopCloser::addKeyframe(const PoseEstimate& mapped, const LidarScan& cloud,
-                                    const KeyframeKeypoints* keypoints) {
+                                    KeyframeKeypointsPtr keypoints) {
   std::vector<Eigen::Vector3f> points;
   points.reserve(cloud.points.size());
   for (const LidarPoint& p : cloud.points)
@@ -261,9 +261,8 @@ ScanContext LoopCloser::addKeyframe(const PoseEstimate& mapped, const LidarScan&
   keyframes_.push_back(std::move(kf));
   clouds_.add(CompactCloud::encode(voxelDownsample(points, config_.keyframe_voxel),
                                    static_cast<float>(config_.keyframe_cloud_step)));
-  keypoints_.push_back(keypoints && config_.keypoints.use && !keypoints->empty()
-                           ? std::make_shared<const KeyframeKeypoints>(*keypoints)
-                           : nullptr);
+  if (!config_.keypoints.use || (keypoints && keypoints->empty())) keypoints.reset();
+  keypoints_.push_back(std::move(keypoints));
   ++stats_.keyframes;
   return keyframeScanContext(std::move(points), mapped.pose, config_.level_scan_context, config_.scan_context);
 }

@@ -17,9 +17,9 @@
 #include "core/config_table.hpp"
 #include "core/types.hpp"
 #include "loop/compact_cloud.hpp"
+#include "loop/keyframe_cloud_store.hpp"
 #include "loop/keyframe_keypoints.hpp"
 #include "loop/keypoint_seed.hpp"
-#include "loop/keyframe_cloud_store.hpp"
 #include "loop/loop_verifier.hpp"
 #include "loop/odometry_chain.hpp"
 #include "loop/pose_graph.hpp"
@@ -171,8 +171,8 @@ class LoopCloser {
   LoopCloser& operator=(LoopCloser&&) noexcept;
 
   // cloud: deskewed sweep in the lidar frame at mapped.utime; keypoints: the sweep's LinK3D keypoints (FEATURES),
-  // if known: kept with a keyframe's cloud to seed and check verification (loop.keypoints).
-  Result process(const PoseEstimate& mapped, const LidarScan& cloud, const KeyframeKeypoints* keypoints = nullptr);
+  // null if unknown: kept with a keyframe's cloud to seed and check verification (loop.keypoints).
+  Result process(const PoseEstimate& mapped, const LidarScan& cloud, KeyframeKeypointsPtr keypoints = nullptr);
   // End of input: applies every job still in flight (waiting for the worker).
   Result finish();
   // Loop jobs posted but not applied yet, and the wall time (ms, measurement only) sweeps waited for them.
@@ -216,7 +216,7 @@ class LoopCloser {
 
  private:
   bool isKeyframe(const Eigen::Isometry3d& pose) const;
-  ScanContext addKeyframe(const PoseEstimate& mapped, const LidarScan& cloud, const KeyframeKeypoints* keypoints);
+  ScanContext addKeyframe(const PoseEstimate& mapped, const LidarScan& cloud, KeyframeKeypointsPtr keypoints);
   bool isRevisit(int keyframe) const;
   Matrix6d stepCovariance(const Eigen::Isometry3d& new_pose) const;
   void submitJob(int query, const ScanContext& context);

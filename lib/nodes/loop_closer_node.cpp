@@ -131,15 +131,16 @@ class LoopCloserNode : public runtime::Node, public WritesProducts, public Write
     std::vector<Eigen::Vector3f> points;
     std::vector<LinK3dDescriptor> descriptors;
     msg::keypointsOf(m, points, descriptors);
-    recent_keypoints_.emplace_back(m.header.utime, KeyframeKeypoints::encode(points, descriptors));
+    recent_keypoints_.emplace_back(m.header.utime,
+                                   std::make_shared<const KeyframeKeypoints>(KeyframeKeypoints::encode(points, descriptors)));
     if (recent_keypoints_.size() > kRecentKeypoints) recent_keypoints_.pop_front();
   }
 
-  // The keypoints of the sweep at utime, if its FEATURES came; older ones are dropped.
-  std::optional<KeyframeKeypoints> takeKeypoints(std::int64_t utime) {
+  // The keypoints of the sweep at utime (null if its FEATURES never came); older ones are dropped.
+  KeyframeKeypointsPtr takeKeypoints(std::int64_t utime) {
     while (!recent_keypoints_.empty() && recent_keypoints_.front().first < utime) recent_keypoints_.pop_front();
-    if (recent_keypoints_.empty() || recent_keypoints_.front().first != utime) return std::nullopt;
-    std::optional<KeyframeKeypoints> out = std::move(recent_keypoints_.front().second);
+    if (recent_keypoints_.empty() || recent_keypoints_.front().first != utime) return nullptr;
+    KeyframeKeypointsPtr out = std::move(recent_keypoints_.front().second);
     recent_keypoints_.pop_front();
     return out;
   }
@@ -150,8 +151,7 @@ class LoopCloserNode : public runtime::Node, public WritesProducts, public Write
     mapped.pose = makePose(m.loop_correction_position, m.loop_correction_orientation).inverse() * mapped.pose;
     const LidarScan cloud = msg::featuresOf(m).cloud;
     trajectory_.push_back({mapped.utime, mapped.pose});
-    const std::optional<KeyframeKeypoints> keypoints = takeKeypoints(mapped.utime);
-    const LoopCloser::Result result = closer_.process(mapped, cloud, keypoints ? &*keypoints : nullptr);
+    const LoopCloser::Result result = closer_.process(mapped, cloud, takeKeypoints(mapped.utime));
     publishResult(mapped.utime, result);
     if (const auto update = updates_.update(mapped.utime, closer_)) publishMapUpdate(*update);
     const LoopCloserStats& s = closer_.stats();
@@ -350,7 +350,7 @@ class LoopCloserNode : public runtime::Node, public WritesProducts, public Write
 
   LoopCloser closer_;
   static constexpr std::size_t kRecentKeypoints = 16;
-  std::deque<std::pair<std::int64_t, KeyframeKeypoints>> recent_keypoints_;  // utime, keypoints
+  std::deque<std::pair<std::int64_t, KeyframeKeypointsPtr>> recent_keypoints_;  // utime, keypoints
   LoopCloserNodeConfig node_;  // map voxel, checkpoint spacing, clouds kept in memory
   MapUpdateTracker updates_;
   std::map<std::string, std::string> config_keys_;  // every pipeline key, for the bundle's config.yaml

@@ -248,8 +248,8 @@ TEST(KeypointSeed, KeyframeKeypointsSurviveACheckpointAndOlderRecordsStillLoad) 
     LidarScan scan = simulateSweep(world, pe.pose, static_cast<std::uint32_t>(k + 1), 450);
     scan.utime = pe.utime;
     const FeatureSet f = FeatureExtractor(FeatureConfig{}).process(scan, {}, MotionPrior{});
-    const KeyframeKeypoints keypoints = KeyframeKeypoints::encode(f.keypoints, f.descriptors);
-    closer.process(pe, scan, k == 2 ? nullptr : &keypoints);  // keyframe 2: its FEATURES never came
+    const auto keypoints = std::make_shared<const KeyframeKeypoints>(KeyframeKeypoints::encode(f.keypoints, f.descriptors));
+    closer.process(pe, scan, k == 2 ? nullptr : keypoints);  // keyframe 2: its FEATURES never came
   }
   closer.finish();
   ASSERT_EQ(closer.keyframes().size(), 4u);
