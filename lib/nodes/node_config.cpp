@@ -5,6 +5,7 @@
 #include "map/map_updates.hpp"
 #include "map/relocaliser.hpp"
 #include "mapping/scan_to_map.hpp"
+#include "odometry/gyro_bias.hpp"
 #include "odometry/initial_guess.hpp"
 #include "odometry/scan_to_scan.hpp"
 #include "odometry/wheel_motion.hpp"
@@ -129,6 +130,7 @@ std::vector<ConfigKeyInfo> pipelineConfigDescription(const Config& c) {
   describeInto(scanToScanConfigTable(), scanToScanConfigFrom(c), keys);
   describeInto(initialGuessConfigTable(), initialGuessConfigFrom(c), keys);
   describeInto(wheelMotionConfigTable(), wheelMotionConfigTable().read(c), keys);
+  describeInto(gyroBiasConfigTable(), gyroBiasConfigTable().read(c), keys);
   describeInto(mapperConfigTable(), mapperConfigFrom(c), keys);
   describeInto(loopCloserConfigTable(), loopCloserConfigFrom(c), keys);
   describeInto(featureNodeConfigTable(), featureNodeConfigTable().read(c), keys);

@@ -6,6 +6,8 @@
 #include "nodes/sample_buffer.hpp"
 #include "nodes/node_config.hpp"
 #include "nodes/run_state.hpp"
+#include "features/deskew.hpp"
+#include "odometry/gyro_bias.hpp"
 #include "odometry/initial_guess.hpp"
 #include "registration/pose_increment.hpp"
 #include "odometry/scan_to_scan.hpp"
@@ -32,10 +34,12 @@ class OdometryNode : public runtime::Node {
   explicit OdometryNode(const Config& config)
       : Node("odometry"),
         odometry_(scanToScanConfigFrom(config)),
+        odometry_config_(scanToScanConfigFrom(config)),
         guess_config_(initialGuessConfigFrom(config)),
         imu_(odometryNodeConfigTable().read(config).imu_keep_s),
         wheel_buffer_(odometryNodeConfigTable().read(config).imu_keep_s),
         wheel_(wheelMotionConfigTable().read(config)),
+        gyro_bias_(gyroBiasConfigTable().read(config)),
         state_("odometry") {
     const OdometryNodeConfig node = odometryNodeConfigTable().read(config);
     forward_voxel_ = node.forward_cloud_voxel;
@@ -93,7 +97,9 @@ class OdometryNode : public runtime::Node {
   void onFeatures(const adit::features_t& m) {
     FeatureSet features = msg::fromMessage(m);
     if (resume_) resumeFrom(*resume_, features.utime);
-    const std::vector<ImuSample> imu = imu_.samples();
+    const std::vector<ImuSample> raw_imu = imu_.samples();
+    // The gyro seeds (and weighs) the registration only with its bias removed, once a stop has measured it.
+    const std::vector<ImuSample> imu = gyro_bias_.known() ? withoutGyroBias(raw_imu, gyro_bias_.bias()) : raw_imu;
     const InitialGuess guess = initialGuess(previous_ ? &*previous_ : nullptr, features,
                                             odometry_.predictMotion(features.utime),
                                             odometry_.hasVelocity(features.utime), imu, guess_config_);
@@ -103,9 +109,20 @@ class OdometryNode : public runtime::Node {
     const std::optional<WheelMotionEstimate> wheel = wheelMotion(features.utime, guess);
     const Eigen::Isometry3d before = odometry_.pose();
     const std::int64_t previous_utime = odometry_.lastUtime();
+    const std::optional<RotationPrior> gyro = gyroRotation(imu, previous_utime, features.utime);
+    if (gyro) count("gyro_rotation_weighed");
     const PoseEstimate pose = odometry_.process(
         features, guess.T_prev_curr, guess.flags,
-        wheel ? std::optional<MeasuredMotion>(MeasuredMotion{wheel->T_prev_curr, wheel->sigma_translation_m}) : std::nullopt);
+        wheel ? std::optional<MeasuredMotion>(MeasuredMotion{wheel->T_prev_curr, wheel->sigma_translation_m}) : std::nullopt,
+        gyro);
+    if (previous_utime >= 0) {
+      gyro_bias_.observe(raw_imu, previous_utime, features.utime, before.inverse() * pose.pose,
+                         !(pose.flags & PoseEstimate::kRegistrationFailed));
+      if (gyro_bias_.known()) {
+        setCount("gyro_bias_stops", gyro_bias_.restPeriods());
+        setCount("gyro_bias_mdeg_s", static_cast<std::int64_t>(std::lround(gyro_bias_.bias().norm() * 180e3 / M_PI)));
+      }
+    }
     if (pose.flags & PoseEstimate::kRegistrationFailed) count("registration_failed");
     if (pose.flags & PoseEstimate::kDegenerateTranslation) {
       count("degenerate_translation");
@@ -130,6 +147,19 @@ class OdometryNode : public runtime::Node {
     publish("odometry", out);
     if (state_.live() && pose.utime - last_checkpoint_utime_ >= checkpoint_period_us_) checkpoint();
     reportCheckpoints();
+  }
+
+  // The gyro's rotation R_prev_curr over the interval, bias-corrected once a stop has measured the bias, with
+  // its uncertainty, for the registration to weigh: none with the weighing off or where the samples do not
+  // cover the interval.
+  std::optional<RotationPrior> gyroRotation(const std::vector<ImuSample>& imu, std::int64_t previous, std::int64_t utime) const {
+    if (previous < 0 || imu.empty() || !(odometry_config_.gyro_rotation_sigma_rad > 0.0)) return std::nullopt;
+    const double interval = toSeconds(utime - previous);
+    const auto rotations = features::imuRotations(imu, utime, {-interval}, guess_config_.R_lidar_imu, guess_config_.max_imu_gap_s);
+    if (rotations.empty()) return std::nullopt;
+    // rotations[0] is R_curr_prev.
+    return RotationPrior{rotations.front().conjugate().toRotationMatrix(),
+                         gyro_bias_.rotationSigma(odometry_config_.gyro_rotation_sigma_rad, interval)};
   }
 
   // The wheel's motion since the previous sweep (none without WHEEL_ODOM, before two sweeps, or when the
@@ -193,10 +223,12 @@ class OdometryNode : public runtime::Node {
   }
 
   ScanToScanOdometry odometry_;
+  ScanToScanConfig odometry_config_;
   InitialGuessConfig guess_config_;
   ImuBuffer imu_;
   WheelBuffer wheel_buffer_;
   WheelMotion wheel_;
+  GyroBiasEstimator gyro_bias_;
   double forward_voxel_ = 0.1;
   std::int64_t checkpoint_period_us_ = 500000;
   double max_extrapolation_s_ = 5.0;

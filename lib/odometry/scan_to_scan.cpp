@@ -40,6 +40,7 @@ ScanToScanConfig aloamOdometryConfig() {
   s.registration.reuse_match_distance_m = 0.0;  // A-LOAM searches every round afresh
   s.max_match_distance_m = 5.0;
   s.startup_max_speed_mps = 0.0;
+  s.gyro_rotation_sigma_rad = 0.0;  // A-LOAM has no IMU
   return s;
 }
 
@@ -73,6 +74,7 @@ const ConfigTable<ScanToScanConfig>& scanToScanConfigTable() {
      .add("max_velocity_gap_s", &S::max_velocity_gap_s, above(0), "s", "longest gap over which the constant-velocity model extrapolates")
      .add("hold_velocity_time_constant_s", &S::hold_velocity_time_constant_s, atLeast(0), "s", "averaging of the velocity degenerate directions hold to; 0 = last motion")
      .add("hold_velocity_observed_ratio", &S::hold_velocity_observed_ratio, between(0, 1), "", "that average weighs a translation direction fully from this eigenvalue ratio on (all residuals), not at all where degenerate; 0 = unweighted")
+     .add("gyro_rotation_sigma_rad", &S::gyro_rotation_sigma_rad, atLeast(0), "rad", "per-sweep sigma of the bias-corrected gyro rotation the registration weighs (0: the gyro only seeds)")
      .add("startup_max_speed_mps", &S::startup_max_speed_mps, atLeast(0), "m/s", "fastest a vehicle may already move when odometry starts (start-up search range; 0 = no search)")
      .add("startup_search_step_m", &S::startup_search_step_m, above(0), "m", "spacing of the start-up search's seeds along the forward axis")
      .add("startup_inlier_distance_m", &S::startup_inlier_distance_m, above(0), "m", "residual below which a correspondence counts for a start-up seed");
@@ -251,7 +253,8 @@ Correspondences ScanToScanOdometry::match(const std::vector<LidarPoint>& sharp, 
 }
 
 ScanToScanOdometry::Refinement ScanToScanOdometry::refine(const SweepPoints& cur, const Eigen::Isometry3d& seed,
-                                                         const Eigen::Isometry3d& hold, bool can_hold) const {
+                                                         const Eigen::Isometry3d& hold, bool can_hold,
+                                                         const RotationPrior* gyro) const {
   RegistrationConfig registration = config_.registration;
   registration.degeneracy_prior = registration.degeneracy_prior && can_hold;
   Refinement out;
@@ -259,7 +262,7 @@ ScanToScanOdometry::Refinement ScanToScanOdometry::refine(const SweepPoints& cur
   out.ok = true;
   MatchReuse reuse(cur.sharp.size(), cur.flat.size(), config_.registration.reuse_match_distance_m);
   for (int round = 0; round < std::max(1, config_.outer_iterations); ++round) {
-    out.result = registerStep(match(cur.sharp, cur.flat, out.pose, &reuse), out.pose, hold, registration);
+    out.result = registerStep(match(cur.sharp, cur.flat, out.pose, &reuse), out.pose, hold, registration, gyro);
     out.iterations += out.result.iterations;
     if (!(out.ok = out.result.ok)) break;
     const bool converged = hasConverged(out.pose, out.result.pose);
@@ -271,14 +274,14 @@ ScanToScanOdometry::Refinement ScanToScanOdometry::refine(const SweepPoints& cur
 
 ScanToScanOdometry::Refinement ScanToScanOdometry::searchStart(const SweepPoints& cur, const Eigen::Isometry3d& seed,
                                                                const Eigen::Isometry3d& hold, bool can_hold,
-                                                               double gap_s) const {
+                                                               double gap_s, const RotationPrior* gyro) const {
   const double reach = config_.startup_max_speed_mps * std::max(0.0, gap_s);
   Refinement best;
   best.pose = seed;
   int best_inliers = -1;
   const std::vector<Eigen::Isometry3d> hypotheses = startupHypotheses(seed, reach, config_.startup_search_step_m);
   for (std::size_t i = 0; i < hypotheses.size(); ++i) {
-    Refinement r = refine(cur, hypotheses[i], hold, can_hold);
+    Refinement r = refine(cur, hypotheses[i], hold, can_hold, gyro);
     if (!r.ok) continue;
     const int inliers = inlierCount(match(cur.sharp, cur.flat, r.pose), r.pose, config_.startup_inlier_distance_m);
     r.from_prior = i == 0;
@@ -308,8 +311,11 @@ void ScanToScanOdometry::awaitPrevious() const {
 }
 
 PoseEstimate ScanToScanOdometry::process(const FeatureSet& f, const std::optional<Eigen::Isometry3d>& prior,
-                                         int prior_flags, const std::optional<MeasuredMotion>& measured) {
+                                         int prior_flags, const std::optional<MeasuredMotion>& measured,
+                                         const std::optional<RotationPrior>& weighed_gyro) {
   PoseEstimate out;
+  const std::optional<RotationPrior> gyro =
+      weighed_gyro && weighed_gyro->R.allFinite() && weighed_gyro->sigma_rad > 0.0 ? weighed_gyro : std::nullopt;
   out.utime = f.utime;
   const Eigen::Isometry3d motion_model = predictMotion(f.utime);
   Eigen::Isometry3d seed = motion_model;
@@ -326,9 +332,11 @@ PoseEstimate ScanToScanOdometry::process(const FeatureSet& f, const std::optiona
   const bool imu_prior = prior_usable && (prior_flags & PoseEstimate::kSeededByImu) != 0;
   // A measured motion (wheel odometry) observes what the lidar cannot: hold to it first.
   const bool held_to_measured = measured && isFinitePose(measured->T_prev_curr);
-  const Eigen::Isometry3d hold = held_to_measured ? measured->T_prev_curr
-                                 : imu_prior      ? *prior
-                                                  : predictHeldMotion(f.utime);
+  Eigen::Isometry3d hold = held_to_measured ? measured->T_prev_curr
+                           : imu_prior      ? *prior
+                                            : predictHeldMotion(f.utime);
+  // A weighed gyro is what a degenerate rotation (the roll of a round roadway) holds to.
+  if (gyro) hold.linear() = gyro->R;
   // Before a velocity is known the motion model says nothing (its identity is not "standing still"):
   // holding a degenerate direction to it would pin the estimate at zero motion.
   const bool can_hold = held_to_measured || imu_prior || hasVelocity(f.utime);
@@ -347,7 +355,7 @@ PoseEstimate ScanToScanOdometry::process(const FeatureSet& f, const std::optiona
   // farther from the truth and is refined once more below (measured on kitti_mini 02: APE 0.033 -> 0.024 m).
   bool refined = false;
   if (has_previous_ && !hasVelocity(f.utime) && config_.startup_max_speed_mps > 0.0) {
-    r = searchStart(cur, seed, hold, can_hold, gap_s);
+    r = searchStart(cur, seed, hold, can_hold, gap_s, gyro ? &*gyro : nullptr);
     refined = r.ok && r.from_prior && !mixed;
     if (!r.ok) r.pose = seed;
   }
@@ -358,7 +366,7 @@ PoseEstimate ScanToScanOdometry::process(const FeatureSet& f, const std::optiona
       if (cur_raw) cur = fixed; else setPrevious(fixed);
     }
     const int iterations = r.iterations;
-    r = refine(cur, r.pose, hold, can_hold);
+    r = refine(cur, r.pose, hold, can_hold, gyro ? &*gyro : nullptr);
     r.iterations += iterations;
     if (!r.ok) break;
   }

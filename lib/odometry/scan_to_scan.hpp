@@ -89,6 +89,12 @@ struct ScanToScanConfig {
   // road vehicle; a mine robot needs far less, but the search costs a few ms per seed, once. 0 = off: the
   // first registration starts from the prior or zero motion (A-LOAM).
   double startup_max_speed_mps = 30.0;
+  // Standard deviation (rad, per axis, per sweep) of the bias-corrected gyro's rotation over a sweep interval
+  // (odometry/gyro_bias.hpp), which the registration weighs its rotation against (process()'s gyro): on a
+  // noisy 16-beam lidar, scan-to-scan rotation errs by ~0.3 deg a sweep at rest and drifts ~20 deg in two
+  // minutes of roadway-loop; an N100-class gyro integrates ~0.003 deg of noise a sweep, and its bias, once
+  // measured at a stop, drifts by ~1 deg in those two minutes. 0 = the gyro only seeds the registration.
+  double gyro_rotation_sigma_rad = 1e-4;
   double startup_search_step_m = 0.5;
   double startup_inlier_distance_m = 0.1;
 };
@@ -128,8 +134,11 @@ class ScanToScanOdometry {
   // Never throws: a sweep that cannot be registered keeps the prior motion and is flagged
   // kRegistrationFailed.
   // `measured`: see MeasuredMotion (flagged kPoseHeldToWheel when used).
+  // `gyro`: the gyro's rotation R_prev_curr over the interval and its uncertainty, which the registration's
+  // rotation is weighed against.
   PoseEstimate process(const FeatureSet& f, const std::optional<Eigen::Isometry3d>& prior_T_prev_curr = std::nullopt,
-                       int prior_flags = 0, const std::optional<MeasuredMotion>& measured = std::nullopt);
+                       int prior_flags = 0, const std::optional<MeasuredMotion>& measured = std::nullopt,
+                       const std::optional<RotationPrior>& gyro = std::nullopt);
 
   // Constant-velocity guess of T_prev_curr for a sweep at `utime` (identity before two sweeps were seen).
   Eigen::Isometry3d predictMotion(std::int64_t utime) const;
@@ -174,10 +183,10 @@ class ScanToScanOdometry {
   // The start-up search: the refinement of the seed among startupHypotheses(seed, ...) that explains most of
   // the sweep, for an interval of gap_s (ok false if none could be refined).
   Refinement searchStart(const SweepPoints& cur, const Eigen::Isometry3d& seed, const Eigen::Isometry3d& hold,
-                         bool can_hold, double gap_s) const;
+                         bool can_hold, double gap_s, const RotationPrior* gyro) const;
   // Outer rounds (correspondences recomputed each) from `seed` until converged or out of rounds.
   Refinement refine(const SweepPoints& cur, const Eigen::Isometry3d& seed, const Eigen::Isometry3d& hold,
-                    bool can_hold) const;
+                    bool can_hold, const RotationPrior* gyro) const;
   // in_background: build the index on another thread (when search_threads > 1).
   void setPrevious(const SweepPoints& points, bool in_background = false);
   std::optional<LineFit> fitLocalLine(const Eigen::Vector3d& q, double max_sq) const;

@@ -70,14 +70,18 @@ Linearisation linearise(const LocalProblem& problem, const Vector6d& xi, const R
   return lin;
 }
 
-// The residuals holding each degenerate eigen-direction v of a block to the prior increment:
-// weight * v . (xi - target), weight^2 / sigma^2 = strength * largest eigenvalue of the block.
+// The residuals holding a direction v of the increment to a target value: weight * (v . xi - target).
+// Degenerate eigen-directions of a block are held to the motion model's increment with
+// weight^2 / sigma^2 = strength * largest eigenvalue of the block; a measured rotation holds each rotation
+// axis with weight = sigma / its own sigma (sigma: the point residuals', so both share one scale).
 struct DirectionalPrior {
   Vector6d v;
   double weight;
+  double target = 0.0;
 };
 
-std::vector<DirectionalPrior> directionalPriors(const DegeneracyReport& d, const RegistrationConfig& c) {
+std::vector<DirectionalPrior> directionalPriors(const DegeneracyReport& d, const RegistrationConfig& c,
+                                               const Vector6d& target) {
   std::vector<DirectionalPrior> priors;
   for (int block = 0; block < 2; ++block) {
     const auto& degenerate = block == 0 ? d.translation_degenerate : d.rotation_degenerate;
@@ -88,17 +92,29 @@ std::vector<DirectionalPrior> directionalPriors(const DegeneracyReport& d, const
       if (!degenerate[i]) continue;
       Vector6d v = Vector6d::Zero();
       v.segment<3>(3 * block) = dirs.col(i);
-      priors.push_back({v, std::sqrt(c.degeneracy_prior_strength * largest) * c.point_sigma_m});
+      priors.push_back({v, std::sqrt(c.degeneracy_prior_strength * largest) * c.point_sigma_m, v.dot(target)});
     }
   }
   return priors;
 }
 
+// The rotation prior's three axes at the linearisation pose T0: T0 * Exp(xi) has R0 * exp(phi), so phi
+// is held to log(R0^T R) about each axis.
+void addRotationPrior(const RotationPrior& prior, const Eigen::Isometry3d& T0, const RegistrationConfig& c,
+                      std::vector<DirectionalPrior>& priors) {
+  const Eigen::AngleAxisd aa(T0.linear().transpose() * prior.R);
+  const Eigen::Vector3d phi = aa.angle() * aa.axis();
+  for (int i = 0; i < 3; ++i) {
+    Vector6d v = Vector6d::Zero();
+    v[3 + i] = 1.0;
+    priors.push_back({v, c.point_sigma_m / prior.sigma_rad, phi[i]});
+  }
+}
+
 // The measurements' normal equations plus the priors' at xi.
-Linearisation withPriors(Linearisation lin, const std::vector<DirectionalPrior>& priors, const Vector6d& xi,
-                         const Vector6d& target) {
+Linearisation withPriors(Linearisation lin, const std::vector<DirectionalPrior>& priors, const Vector6d& xi) {
   for (const DirectionalPrior& p : priors) {
-    const double r = p.weight * p.v.dot(xi - target);
+    const double r = p.weight * (p.v.dot(xi) - p.target);
     lin.H.noalias() += (p.weight * p.weight) * p.v * p.v.transpose();
     lin.g.noalias() += (p.weight * r) * p.v;
     lin.cost += 0.5 * r * r;
@@ -117,22 +133,21 @@ struct Solution {
 // that raises the cost is halved (at most a few times) rather than taken: Levenberg-Marquardt's safety at the
 // price of one more linearisation.
 Solution gaussNewton(const LocalProblem& problem, const Linearisation& at_zero,
-                     const std::vector<DirectionalPrior>& priors, const Vector6d& target, const RobustKernel& kernel,
-                     int max_iterations) {
+                     const std::vector<DirectionalPrior>& priors, const RobustKernel& kernel, int max_iterations) {
   Solution s;
   s.measurements = at_zero;
-  Linearisation lin = withPriors(at_zero, priors, s.xi, target);
+  Linearisation lin = withPriors(at_zero, priors, s.xi);
   for (int it = 0; it < max_iterations; ++it) {
     ++s.iterations;
     const Vector6d step = -(lin.H + 1e-12 * Matrix6d::Identity()).ldlt().solve(lin.g);
     if (!step.allFinite()) break;
     Vector6d next = s.xi + step;
     Linearisation next_meas = linearise(problem, next, kernel);
-    Linearisation next_lin = withPriors(next_meas, priors, next, target);
+    Linearisation next_lin = withPriors(next_meas, priors, next);
     for (int halvings = 0; halvings < 4 && next_lin.cost > lin.cost; ++halvings) {
       next = s.xi + (next - s.xi) * 0.5;
       next_meas = linearise(problem, next, kernel);
-      next_lin = withPriors(next_meas, priors, next, target);
+      next_lin = withPriors(next_meas, priors, next);
     }
     if (next_lin.cost > lin.cost) break;  // no descent along the Gauss-Newton direction: xi is the minimum
     const Vector6d moved = next - s.xi;
@@ -185,7 +200,8 @@ ConfigTable<RegistrationConfig> registrationConfigTable(const std::string& prefi
 }
 
 RegistrationResult registerStep(const Correspondences& matches, const Eigen::Isometry3d& T0,
-                                const Eigen::Isometry3d& motion_prior, const RegistrationConfig& config) {
+                                const Eigen::Isometry3d& motion_prior, const RegistrationConfig& config,
+                                const RotationPrior* rotation_prior) {
   RegistrationResult result;
   result.pose = T0;
   result.num_correspondences = static_cast<int>(matches.size());
@@ -201,9 +217,11 @@ RegistrationResult registerStep(const Correspondences& matches, const Eigen::Iso
   const DegeneracyReport d0 = analyzeDegeneracy(H0, config.degeneracy_ratio_translation, config.degeneracy_ratio_rotation);
   const bool hold = config.degeneracy_prior && d0.flags != 0 && isFinitePose(motion_prior);
   const Vector6d target = hold ? incrementBetween(T0, motion_prior) : Vector6d::Zero();
-  const std::vector<DirectionalPrior> priors = hold ? directionalPriors(d0, config) : std::vector<DirectionalPrior>{};
+  std::vector<DirectionalPrior> priors = hold ? directionalPriors(d0, config, target) : std::vector<DirectionalPrior>{};
+  if (rotation_prior && rotation_prior->R.allFinite() && rotation_prior->sigma_rad > 0.0)
+    addRotationPrior(*rotation_prior, T0, config, priors);
 
-  const Solution solved = gaussNewton(problem, at_T0, priors, target, kernel, std::max(1, config.max_solver_iterations));
+  const Solution solved = gaussNewton(problem, at_T0, priors, kernel, std::max(1, config.max_solver_iterations));
   result.iterations = solved.iterations;
   result.final_cost = solved.cost;
   Vector6d solution = solved.xi;

@@ -77,10 +77,18 @@ struct RegistrationResult {
   int num_correspondences = 0;
 };
 
+// A rotation measured by another sensor (a gyro integrated over the sweep interval): T's rotation is held
+// to R with a standard deviation of sigma_rad about each axis, beside the point residuals.
+struct RotationPrior {
+  Eigen::Matrix3d R = Eigen::Matrix3d::Identity();  // reference_R_sweep
+  double sigma_rad = 1e-3;
+};
+
 // Solves for the pose T (reference_T_sweep) starting at T0. `motion_prior` is the motion model's guess of T,
-// used only along degenerate directions.
+// used only along degenerate directions; `rotation_prior` (optional) weighs T's rotation in every direction.
 RegistrationResult registerStep(const Correspondences& matches, const Eigen::Isometry3d& T0,
-                                const Eigen::Isometry3d& motion_prior, const RegistrationConfig& config);
+                                const Eigen::Isometry3d& motion_prior, const RegistrationConfig& config,
+                                const RotationPrior* rotation_prior = nullptr);
 
 // Copies a successful result's covariance (degenerate directions inflated to the prior), eigenvalues,
 // degeneracy flags and cost into `out`.

@@ -2,9 +2,10 @@
 // once with an exact lidar and IMU and no vibration, once with the sensors' noise and the chassis vibrating
 // (engine idling, sim.motion.idle_vibration). What the estimate does there is a bias, nothing else. The issue's
 // targets (ODOM_SCAN within 1 cm and 0.05 deg, the pipeline within 5 mm) are not reached (README, "Bias at
-// rest"): ODOM_SCAN's figures are printed, not asserted (it drifts 0.5-5 m in 60 s with the default less-flat
-// centroids; exactly 0 with exact sensors and features.loam.less_flat_measured + odometry.plane_through_nearest);
-// the pipeline is held to what it measures, with margin.
+// rest"): ODOM_SCAN's rotation is held to what it measures with the gyro weighed, its translation is printed,
+// not asserted (it drifts 0.4-5 m in 60 s with the default less-flat centroids; exactly 0 with exact sensors
+// and features.loam.less_flat_measured + odometry.plane_through_nearest); the pipeline is held to what it
+// measures, with margin.
 #include "sim_pipeline.hpp"
 
 #include <gtest/gtest.h>
@@ -56,6 +57,10 @@ void expectAtRest(const std::string& world, bool noisy) {
   std::printf("%-16s %-6s at rest %.0f s: scan-to-scan %.2f mm %.4f deg, pipeline %.2f mm %.4f deg\n",
               world.c_str(), noisy ? "noisy" : "exact", kRestSeconds, 1e3 * scan.metres, scan.degrees,
               1e3 * full.metres, full.degrees);
+  // ODOM_SCAN's rotation, with the gyro weighed (odometry.gyro_rotation_sigma_rad; its bias measured while the
+  // robot stands): exact 0.06, 0.16, 0.31, 0.05 deg (loop, straight, room-and-pillar, featureless; before
+  // 1.7-21 deg), noisy 2.6-2.8 deg (before 18-55 deg). Its translation is not held (0.4-5 m).
+  EXPECT_LT(scan.degrees, noisy ? 4.0 : 0.5) << world << (noisy ? " noisy" : " exact");
   // Measured, exact: 16.3 mm / 0.26 deg (roadway-loop: the mapper's first second), 3.9, 1.9, 6.4 mm.
   EXPECT_LT(full.metres, noisy ? kNoisyPipelineMetres : 0.025) << world << (noisy ? " noisy" : " exact");
   EXPECT_LT(full.degrees, noisy ? kNoisyPipelineDegrees : 0.4) << world << (noisy ? " noisy" : " exact");
@@ -101,8 +106,12 @@ TEST(ScanDriftSim, RoadwayLoopScanToScanAlone) {
               "%.2f deg; mapped %.3f m (%.2f %%)\n", seconds, distance, scan_error, 100 * scan_error / distance,
               scan_path, 100 * (scan_path / distance - 1), rotationAngle(truth.inverse() * scan) * 180 / M_PI,
               mapped_error, 100 * mapped_error / distance);
-  // Measured 3.47 % (5.2 m over 150 m, heading 21 deg off at the end); the issue's target is 2 %.
+  // Measured 1.72 % (2.6 m over 150 m; 3.68 % and 4.26 % with seeds 2 and 3), heading 2.9 deg off at the end.
+  // Before the gyro weighed the rotation (odometry.gyro_rotation_sigma_rad): 3.12 % here, heading 22.9 deg
+  // off (11-12 deg with seeds 2 and 3). What is left is translation: the estimate climbs 3-5 mm a sweep (edge
+  // lines, README "Bias at rest"). The issue's target is 2 %.
   EXPECT_LT(scan_error, 0.05 * distance);
+  EXPECT_LT(rotationAngle(truth.inverse() * scan) * 180 / M_PI, 6.0);
 }
 
 }  // namespace

@@ -1,0 +1,89 @@
+// The gyro's bias, measured whenever the robot stands still. A MEMS gyro (N100 class) turns on with a bias
+// of ~0.2 deg/s that drifts with temperature; integrated over a sweep it is a rotation the lidar does not
+// make, so a gyro that seeds or weighs the registration must have it removed. At rest the true rate is zero
+// (an idling chassis shakes about zero), so the mean reading over a still period is the bias.
+//
+// A sweep interval is still when the lidar odometry's step is short (rest_translation_m) and the gyro turned
+// less than rest_rotation_deg over it.
+// A still period ends at a moving step, or when the mean acceleration over its last window_s leaves the
+// mean of the period before it by accel_tolerance_mps2: a vehicle pulling away slowly accelerates before the
+// lidar sees it move, while an idling chassis' vibration (1-4 Hz) averages out over the window. The estimate
+// is the mean rate over the period without its newest guard_s (not trusted until more follows), once that
+// spans min_rest_s; each period is blended with the estimate before it, weighed by its length squared
+// (gyro_bias.cpp says why), older periods fading with time_constant_s. Deterministic: depends only on the samples and steps given, in order.
+#pragma once
+
+#include "core/config_table.hpp"
+#include "core/types.hpp"
+
+#include <deque>
+#include <vector>
+
+namespace adit {
+
+struct GyroBiasConfig {
+  // A lidar step shorter than this, with the gyro turning less than the angle, may be still. Generous:
+  // scan-to-scan odometry at rest moves ~1-3 cm a sweep on a noisy 16-beam lidar; a mine robot under way
+  // makes >= 5 cm (0.5 m/s). An idling chassis rocks by up to ~0.4 deg a sweep.
+  double rest_translation_m = 0.05;
+  double rest_rotation_deg = 1.0;
+  double accel_tolerance_mps2 = 0.1;  // the recent window's mean acceleration against the period's before it
+  double window_s = 1.0;
+  double min_rest_s = 1.0;         // still this long (after the guard) before the mean counts as the bias
+  double guard_s = 0.5;            // the newest part of a still period, not trusted until more follows
+  double time_constant_s = 600.0;  // older periods fade with this time constant (the bias drifts with temperature)
+  // A larger mean rate while still is not a bias but a slow turn misread as still (N100-class turn-on bias:
+  // ~0.2 deg/s, 1 sigma).
+  double max_bias_rad_s = 0.02;
+  // The bias's standard deviation before a stop has measured it (per axis): the gyro is still far better
+  // than a noisy 16-beam lidar's rotation over one sweep, with its rotation's sigma widened by this times
+  // the interval.
+  double initial_sigma_rad_s = 0.005;
+};
+
+// Keys "odometry.gyro_bias.*".
+const ConfigTable<GyroBiasConfig>& gyroBiasConfigTable();
+
+class GyroBiasEstimator {
+ public:
+  explicit GyroBiasEstimator(const GyroBiasConfig& config = {}) : config_(config) {}
+
+  // One sweep interval (t0, t1] (utime), the IMU samples around it (IMU frame; those outside are ignored) and
+  // the lidar odometry's step over it (its translation counts; step_valid false: a failed or missing registration, which ends a still
+  // period like a moving step).
+  void observe(const std::vector<ImuSample>& imu, std::int64_t t0, std::int64_t t1, const Eigen::Isometry3d& step,
+               bool step_valid);
+
+  bool known() const { return weight_ > 0.0; }
+  const Eigen::Vector3d& bias() const { return bias_; }  // rad/s, IMU frame (zero until known)
+  int restPeriods() const { return periods_; }           // still periods blended in so far
+  // The sigma of a gyro rotation over interval_s (sigma_rad with the bias known): widened by the unknown
+  // bias (initial_sigma_rad_s) before a stop measured it.
+  double rotationSigma(double sigma_rad, double interval_s) const;
+
+ private:
+  struct Interval {
+    std::int64_t t0 = 0, t1 = 0;
+    Eigen::Vector3d rate_sum = Eigen::Vector3d::Zero(), accel_sum = Eigen::Vector3d::Zero();
+    double samples = 0.0;
+  };
+  bool accelerating() const;
+  void endPeriod();
+  void update();
+
+  GyroBiasConfig config_;
+  Eigen::Vector3d bias_ = Eigen::Vector3d::Zero();
+  double weight_ = 0.0;  // behind bias_ (s^2, faded)
+  // The estimate before the still period in progress (faded to its start) and that period's intervals.
+  Eigen::Vector3d base_ = Eigen::Vector3d::Zero();
+  double base_weight_ = 0.0;
+  std::int64_t base_utime_ = 0;
+  std::deque<Interval> period_;
+  bool counted_ = false;   // the period in progress has entered the estimate
+  int periods_ = 0;
+};
+
+// The samples with `bias` removed from their rates.
+std::vector<ImuSample> withoutGyroBias(std::vector<ImuSample> imu, const Eigen::Vector3d& bias);
+
+}  // namespace adit
