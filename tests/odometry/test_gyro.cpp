@@ -3,6 +3,7 @@
 #include "core/geometry.hpp"
 #include "odometry/gyro_bias.hpp"
 #include "registration/solver.hpp"
+#include "synthetic_world.hpp"
 
 #include <gtest/gtest.h>
 
@@ -123,11 +124,8 @@ struct GyroStream {
   }
 };
 
-Eigen::Isometry3d stepOf(double metres) {
-  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.translation().x() = metres;
-  return T;
-}
+// The lidar's step over a sweep interval: forward by `metres`.
+Eigen::Isometry3d stepOf(double metres) { return test::poseFrom(metres, 0.0, 0.0, 0.0, 0.0, 0.0); }
 
 TEST(GyroBias, MeasuredWhileTheRobotStandsOnAnIdlingChassis) {
   GyroStream gyro;
