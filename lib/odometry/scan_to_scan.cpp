@@ -32,6 +32,7 @@ ScanToScanConfig aloamOdometryConfig() {
   s.registration.degeneracy_prior = false;
   s.use_link3d_seed = false;
   s.line_min_rings = 2;
+  s.line_through_all_rings = false;
   s.three_point_planes = true;
   s.plane_through_nearest = false;
   s.compensate_mixed_deskew = false;
@@ -64,6 +65,7 @@ const ConfigTable<ScanToScanConfig>& scanToScanConfigTable() {
      .add("plane_neighbours", &S::plane_neighbours, between(3, 100), "points", "nearest previous less-flat points a plane is fitted to")
      .add("plane_max_point_distance_m", &S::plane_max_point_distance_m, above(0), "m", "a plane is rejected if a point is farther from it")
      .add("line_min_rings", &S::line_min_rings, between(2, 64), "rings", "collinear points (one per ring) an edge line needs")
+     .add("line_through_all_rings", &S::line_through_all_rings, anyValue(), "", "where 3+ rings see an edge, its line is fitted to them all and checked, not drawn through the nearest two (A-LOAM: false)")
      .add("line_eigen_ratio", &S::line_eigen_ratio, atLeast(1), "", "line if the largest PCA eigenvalue exceeds ratio * the second")
      .add("line_max_point_distance_m", &S::line_max_point_distance_m, above(0), "m", "a line is rejected if a point is farther from it")
      .add("three_point_planes", &S::three_point_planes, anyValue(), "", "A-LOAM's unchecked three-point planes (ablation only)")
@@ -167,7 +169,9 @@ std::optional<LineFit> ScanToScanOdometry::fitLocalLine(const Eigen::Vector3d& q
     if (k >= 0) pts.push_back(previous_->corners.point(k));
   }
   if (static_cast<int>(pts.size()) < std::max(2, config_.line_min_rings)) return std::nullopt;
-  if (config_.line_min_rings <= 2) {  // A-LOAM's two-point line: the nearest and the closest other-ring point
+  // A-LOAM's two-point line (the nearest and the closest other-ring point), unless more rings see the edge and
+  // the line is to run through them all (line_through_all_rings).
+  if (config_.line_min_rings <= 2 && (pts.size() < 3 || !config_.line_through_all_rings)) {
     std::size_t best = 1;
     for (std::size_t i = 2; i < pts.size(); ++i)
       if ((pts[i] - q).squaredNorm() < (pts[best] - q).squaredNorm()) best = i;

@@ -37,6 +37,17 @@ struct ScanToScanConfig {
   // and nearest on another ring). Measured: 3 is no better on simulated roadways (odometry end error over
   // 20 m within +-0.2 m either way) and worse on kitti_mini (worst pair 0.21-0.23 deg against 0.16-0.20).
   int line_min_rings = 2;
+  // Where three or more rings see the edge (the nearest point on each within ring_window), the line is fitted
+  // to all of them and must pass the checks above, instead of A-LOAM's line through the nearest point and the
+  // closest point on another ring; an edge only two rings see keeps that two-point line. On a 16-beam lidar a
+  // two-point line is often a chord of a curved edge (an arch rib, a rock crest: 17 cm between rings at 5 m),
+  // and a point matched to a chord is pulled off its edge. Measured (roadway-loop 120 s, seeds 1-3, gyro
+  // weighed), scan-to-scan end-point drift: two-point lines 1.72 / 3.68 / 4.26 %, the estimate climbing 3-5 mm
+  // a sweep; with this 2.45 / 1.43 / 2.16 %, a 10 s lidar stall's motion 0.10 -> 0.04 m, the mapped APE 0.0648
+  // -> 0.0643 m. Off: the 12 s demo's map against the simulated world got worse, 0.022 -> 0.035 m mean and
+  // 0.067 -> 0.086 m at the 95th percentile (README, "Bias at rest"). line_min_rings 3 (no two-point lines at
+  // all: 2.54 / 1.23 / 2.23 %) put the stall's motion 0.47 m off.
+  bool line_through_all_rings = false;
   double line_eigen_ratio = 3.0;
   double line_max_point_distance_m = 0.1;
   // Planes are fitted (least squares) to the plane_neighbours nearest previous less-flat points plus the
