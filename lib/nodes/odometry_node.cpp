@@ -34,7 +34,6 @@ class OdometryNode : public runtime::Node {
   explicit OdometryNode(const Config& config)
       : Node("odometry"),
         odometry_(scanToScanConfigFrom(config)),
-        odometry_config_(scanToScanConfigFrom(config)),
         guess_config_(initialGuessConfigFrom(config)),
         imu_(odometryNodeConfigTable().read(config).imu_keep_s),
         wheel_buffer_(odometryNodeConfigTable().read(config).imu_keep_s),
@@ -153,13 +152,13 @@ class OdometryNode : public runtime::Node {
   // its uncertainty, for the registration to weigh: none with the weighing off or where the samples do not
   // cover the interval.
   std::optional<RotationPrior> gyroRotation(const std::vector<ImuSample>& imu, std::int64_t previous, std::int64_t utime) const {
-    if (previous < 0 || imu.empty() || !(odometry_config_.gyro_rotation_sigma_rad > 0.0)) return std::nullopt;
+    if (previous < 0 || imu.empty() || !(odometry_.config().gyro_rotation_sigma_rad > 0.0)) return std::nullopt;
     const double interval = toSeconds(utime - previous);
     const auto rotations = features::imuRotations(imu, utime, {-interval}, guess_config_.R_lidar_imu, guess_config_.max_imu_gap_s);
     if (rotations.empty()) return std::nullopt;
     // rotations[0] is R_curr_prev.
     return RotationPrior{rotations.front().conjugate().toRotationMatrix(),
-                         gyro_bias_.rotationSigma(odometry_config_.gyro_rotation_sigma_rad, interval)};
+                         gyro_bias_.rotationSigma(odometry_.config().gyro_rotation_sigma_rad, interval)};
   }
 
   // The wheel's motion since the previous sweep (none without WHEEL_ODOM, before two sweeps, or when the
@@ -223,7 +222,6 @@ class OdometryNode : public runtime::Node {
   }
 
   ScanToScanOdometry odometry_;
-  ScanToScanConfig odometry_config_;
   InitialGuessConfig guess_config_;
   ImuBuffer imu_;
   WheelBuffer wheel_buffer_;

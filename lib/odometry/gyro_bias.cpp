@@ -40,23 +40,41 @@ void GyroBiasEstimator::observe(const std::vector<ImuSample>& imu, std::int64_t 
   if (!step_valid || !(translationNorm(step) < config_.rest_translation_m) ||
       !(turned < config_.rest_rotation_deg * M_PI / 180.0))
     return endPeriod();
+  if (period_.empty() && settled_.samples <= 0.0) period_start_ = t0;
   period_.push_back(s);
   if (accelerating()) return endPeriod();  // what was trusted stays in the estimate; window and guard are dropped
   update();
+  settle();
+}
+
+// The intervals both before the acceleration window and older than the guard count the same way in every
+// later judgement: their sums are kept instead of them, so a robot parked for hours keeps a few seconds of
+// intervals, not every one.
+void GyroBiasEstimator::settle() {
+  const std::int64_t window_start = period_.back().t1 - toUtime(config_.window_s);
+  const std::int64_t trusted_end = period_.back().t1 - toUtime(config_.guard_s);
+  while (!period_.empty() && period_.front().t0 < window_start && period_.front().t1 <= trusted_end) {
+    const Interval& s = period_.front();
+    settled_.rate_sum += s.rate_sum;
+    settled_.accel_sum += s.accel_sum;
+    settled_.samples += s.samples;
+    settled_.t1 = s.t1;
+    period_.pop_front();
+  }
 }
 
 // The mean acceleration over the newest window_s against the period's before it.
 bool GyroBiasEstimator::accelerating() const {
-  const std::int64_t window_start = period_.back().t1 - static_cast<std::int64_t>(config_.window_s * 1e6);
-  Eigen::Vector3d recent = Eigen::Vector3d::Zero(), before = Eigen::Vector3d::Zero();
-  double n_recent = 0.0, n_before = 0.0;
+  const std::int64_t window_start = period_.back().t1 - toUtime(config_.window_s);
+  Eigen::Vector3d recent = Eigen::Vector3d::Zero(), before = settled_.accel_sum;
+  double n_recent = 0.0, n_before = settled_.samples;
   for (const Interval& s : period_) {
     const bool in_window = s.t0 >= window_start;
     (in_window ? recent : before) += s.accel_sum;
     (in_window ? n_recent : n_before) += s.samples;
   }
   // Judged once the period before the window is a window long too (both means average the vibration).
-  if (n_recent <= 0.0 || n_before <= 0.0 || toSeconds(window_start - period_.front().t0) < config_.window_s) return false;
+  if (n_recent <= 0.0 || n_before <= 0.0 || toSeconds(window_start - period_start_) < config_.window_s) return false;
   return (recent / n_recent - before / n_before).norm() > config_.accel_tolerance_mps2;
 }
 
@@ -65,24 +83,24 @@ bool GyroBiasEstimator::accelerating() const {
 // fraction of a degree) and by the gyro's noise: the first dominates, so a period weighs by its length
 // squared, inverse to that error's variance.
 void GyroBiasEstimator::update() {
-  const std::int64_t trusted_end = period_.back().t1 - static_cast<std::int64_t>(config_.guard_s * 1e6);
-  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-  double samples = 0.0;
-  std::int64_t end = period_.front().t0;
+  const std::int64_t trusted_end = period_.back().t1 - toUtime(config_.guard_s);
+  Eigen::Vector3d sum = settled_.rate_sum;
+  double samples = settled_.samples;
+  std::int64_t end = settled_.samples > 0.0 ? settled_.t1 : period_start_;
   for (const Interval& s : period_) {
     if (s.t1 > trusted_end) break;
     sum += s.rate_sum;
     samples += s.samples;
     end = s.t1;
   }
-  const double length = toSeconds(end - period_.front().t0);
+  const double length = toSeconds(end - period_start_);
   if (samples <= 0.0 || length < config_.min_rest_s) return;
   const Eigen::Vector3d mean = sum / samples;
   if (!(mean.norm() <= config_.max_bias_rad_s)) return;
   if (!counted_) {
     // A new period: what came before fades with the time since it was measured.
     base_ = bias_;
-    base_weight_ = weight_ > 0.0 ? weight_ * std::exp(-toSeconds(period_.front().t0 - base_utime_) / config_.time_constant_s) : 0.0;
+    base_weight_ = weight_ > 0.0 ? weight_ * std::exp(-toSeconds(period_start_ - base_utime_) / config_.time_constant_s) : 0.0;
     counted_ = true;
     ++periods_;
   }
@@ -94,6 +112,7 @@ void GyroBiasEstimator::update() {
 
 void GyroBiasEstimator::endPeriod() {
   period_.clear();
+  settled_ = Interval{};
   counted_ = false;
 }
 

@@ -49,8 +49,8 @@ class GyroBiasEstimator {
   explicit GyroBiasEstimator(const GyroBiasConfig& config = {}) : config_(config) {}
 
   // One sweep interval (t0, t1] (utime), the IMU samples around it (IMU frame; those outside are ignored) and
-  // the lidar odometry's step over it (its translation counts; step_valid false: a failed or missing registration, which ends a still
-  // period like a moving step).
+  // the lidar odometry's step over it (its translation counts; step_valid false: a failed or missing
+  // registration, which ends a still period like a moving step).
   void observe(const std::vector<ImuSample>& imu, std::int64_t t0, std::int64_t t1, const Eigen::Isometry3d& step,
                bool step_valid);
 
@@ -70,14 +70,18 @@ class GyroBiasEstimator {
   bool accelerating() const;
   void endPeriod();
   void update();
+  void settle();
 
   GyroBiasConfig config_;
   Eigen::Vector3d bias_ = Eigen::Vector3d::Zero();
   double weight_ = 0.0;  // behind bias_ (s^2, faded)
-  // The estimate before the still period in progress (faded to its start) and that period's intervals.
+  // The estimate before the still period in progress (faded to its start).
   Eigen::Vector3d base_ = Eigen::Vector3d::Zero();
   double base_weight_ = 0.0;
   std::int64_t base_utime_ = 0;
+  // The still period in progress: when it began, the sums of its settled intervals (settle()), and the rest.
+  std::int64_t period_start_ = 0;
+  Interval settled_;
   std::deque<Interval> period_;
   bool counted_ = false;   // the period in progress has entered the estimate
   int periods_ = 0;

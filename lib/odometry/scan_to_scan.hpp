@@ -92,6 +92,12 @@ struct ScanToScanConfig {
   // its sweeps fall below 0.2). Structured roadways observe their axis at 0.22-0.36 of the largest
   // eigenvalue with all residuals: unaffected. 0 = every direction fully (the unweighted average).
   double hold_velocity_observed_ratio = 0.1;
+  // Standard deviation (rad, per axis, per sweep) of the bias-corrected gyro's rotation over a sweep interval
+  // (odometry/gyro_bias.hpp), which the registration weighs its rotation against (process()'s gyro): on a
+  // noisy 16-beam lidar, scan-to-scan rotation errs by ~0.3 deg a sweep at rest and drifts ~20 deg in two
+  // minutes of roadway-loop; an N100-class gyro integrates ~0.003 deg of noise a sweep, and its bias, once
+  // measured at a stop, drifts by ~1 deg in those two minutes. 0 = the gyro only seeds the registration.
+  double gyro_rotation_sigma_rad = 1e-4;
   // Start-up search (startup_search.hpp): with no motion history (the first pair of a run, after a reset or a
   // restart) the vehicle may already move at any speed up to startup_max_speed_mps. Seeds along the forward
   // axis every startup_search_step_m, up to that speed times the interval, either way, are each refined and
@@ -100,12 +106,6 @@ struct ScanToScanConfig {
   // road vehicle; a mine robot needs far less, but the search costs a few ms per seed, once. 0 = off: the
   // first registration starts from the prior or zero motion (A-LOAM).
   double startup_max_speed_mps = 30.0;
-  // Standard deviation (rad, per axis, per sweep) of the bias-corrected gyro's rotation over a sweep interval
-  // (odometry/gyro_bias.hpp), which the registration weighs its rotation against (process()'s gyro): on a
-  // noisy 16-beam lidar, scan-to-scan rotation errs by ~0.3 deg a sweep at rest and drifts ~20 deg in two
-  // minutes of roadway-loop; an N100-class gyro integrates ~0.003 deg of noise a sweep, and its bias, once
-  // measured at a stop, drifts by ~1 deg in those two minutes. 0 = the gyro only seeds the registration.
-  double gyro_rotation_sigma_rad = 1e-4;
   double startup_search_step_m = 0.5;
   double startup_inlier_distance_m = 0.1;
 };
@@ -166,6 +166,7 @@ class ScanToScanOdometry {
                         const Eigen::Isometry3d& T_prev_curr, MatchReuse* reuse = nullptr) const;
 
   const Eigen::Isometry3d& pose() const { return pose_; }
+  const ScanToScanConfig& config() const { return config_; }
   // The velocity (tangent, per second) of the last step (zero before two sweeps) and the time of the last
   // sweep: what a restart extrapolates (the last step, not the averaged velocity, which lags when the robot
   // speeds up: measured 1.1 m short over a 1.9 s restart gap while accelerating).
