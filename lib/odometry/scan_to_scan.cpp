@@ -2,6 +2,7 @@
 
 #include "registration/feature_fit.hpp"
 #include "registration/match_reuse.hpp"
+#include "core/geometry.hpp"
 #include "core/wheel_odom.hpp"
 #include "odometry/motion_compensation.hpp"
 #include "odometry/startup_search.hpp"
@@ -42,6 +43,8 @@ ScanToScanConfig aloamOdometryConfig() {
   s.max_match_distance_m = 5.0;
   s.startup_max_speed_mps = 0.0;
   s.gyro_rotation_sigma_rad = 0.0;  // A-LOAM has no IMU
+  s.keep_reference_within_m = 0.0;  // A-LOAM registers against the previous sweep, always
+  s.keep_reference_within_rad = 0.0;
   return s;
 }
 
@@ -79,7 +82,9 @@ const ConfigTable<ScanToScanConfig>& scanToScanConfigTable() {
      .add("gyro_rotation_sigma_rad", &S::gyro_rotation_sigma_rad, atLeast(0), "rad", "per-sweep sigma of the bias-corrected gyro rotation the registration weighs (0: the gyro only seeds)")
      .add("startup_max_speed_mps", &S::startup_max_speed_mps, atLeast(0), "m/s", "fastest a vehicle may already move when odometry starts (start-up search range; 0 = no search)")
      .add("startup_search_step_m", &S::startup_search_step_m, above(0), "m", "spacing of the start-up search's seeds along the forward axis")
-     .add("startup_inlier_distance_m", &S::startup_inlier_distance_m, above(0), "m", "residual below which a correspondence counts for a start-up seed");
+     .add("startup_inlier_distance_m", &S::startup_inlier_distance_m, above(0), "m", "residual below which a correspondence counts for a start-up seed")
+     .add("keep_reference_within_m", &S::keep_reference_within_m, atLeast(0), "m", "a sweep this close to the reference sweep leaves it the registration target (at rest errors do not add up; 0 = always the previous sweep)")
+     .add("keep_reference_within_rad", &S::keep_reference_within_rad, atLeast(0), "rad", "and turned less than this from it (0 = always the previous sweep)");
     return t;
   }();
   return table;
@@ -294,6 +299,12 @@ ScanToScanOdometry::Refinement ScanToScanOdometry::searchStart(const SweepPoints
   return best;
 }
 
+bool ScanToScanOdometry::keepsReference(const Eigen::Isometry3d& T_ref_curr) const {
+  return config_.keep_reference_within_m > 0.0 && config_.keep_reference_within_rad > 0.0 &&
+         T_ref_curr.translation().norm() < config_.keep_reference_within_m &&
+         rotationAngle(T_ref_curr) < config_.keep_reference_within_rad;
+}
+
 void ScanToScanOdometry::setPrevious(const SweepPoints& points, bool in_background) {
   prev_points_ = points;
   building_previous_ = {};  // a build still running is waited for (its future's last owner) and dropped
@@ -318,7 +329,7 @@ PoseEstimate ScanToScanOdometry::process(const FeatureSet& f, const std::optiona
                                          int prior_flags, const std::optional<MeasuredMotion>& measured,
                                          const std::optional<RotationPrior>& weighed_gyro) {
   PoseEstimate out;
-  const std::optional<RotationPrior> gyro =
+  std::optional<RotationPrior> gyro =
       weighed_gyro && weighed_gyro->R.allFinite() && weighed_gyro->sigma_rad > 0.0 ? weighed_gyro : std::nullopt;
   out.utime = f.utime;
   const Eigen::Isometry3d motion_model = predictMotion(f.utime);
@@ -341,6 +352,15 @@ PoseEstimate ScanToScanOdometry::process(const FeatureSet& f, const std::optiona
                                             : predictHeldMotion(f.utime);
   // A weighed gyro is what a degenerate rotation (the roll of a round roadway) holds to.
   if (gyro) hold.linear() = gyro->R;
+  // All of the above is over the interval prev -> curr; the registration's target is the reference sweep
+  // (the previous one, or an earlier one kept while the robot barely moves: keep_reference_within_*). The
+  // gyro's step is added to the estimated T_ref_prev, not integrated since the reference: its bias error
+  // then never adds up, and the weighing acts as a complementary filter of gyro and lidar.
+  if (reference_kept_) {
+    seed = ref_T_prev_ * seed;
+    hold = ref_T_prev_ * hold;
+    if (gyro) gyro->R = ref_T_prev_.linear() * gyro->R;
+  }
   // Before a velocity is known the motion model says nothing (its identity is not "standing still"):
   // holding a degenerate direction to it would pin the estimate at zero motion.
   const bool can_hold = held_to_measured || imu_prior || hasVelocity(f.utime);
@@ -366,7 +386,9 @@ PoseEstimate ScanToScanOdometry::process(const FeatureSet& f, const std::optiona
   for (int pass = 0; has_previous_ && !refined && pass < (mixed ? 2 : 1); ++pass) {
     if (mixed) {
       SweepPoints fixed = raw_side;
-      for (auto* v : {&fixed.sharp, &fixed.flat, &fixed.less_sharp, &fixed.less_flat}) compensateMotion(*v, r.pose, gap_s);
+      // The velocity over the last interval moves the raw side, whichever sweep the reference is.
+      const Eigen::Isometry3d step = reference_kept_ ? ref_T_prev_.inverse() * r.pose : r.pose;
+      for (auto* v : {&fixed.sharp, &fixed.flat, &fixed.less_sharp, &fixed.less_flat}) compensateMotion(*v, step, gap_s);
       if (cur_raw) cur = fixed; else setPrevious(fixed);
     }
     const int iterations = r.iterations;
@@ -390,16 +412,24 @@ PoseEstimate ScanToScanOdometry::process(const FeatureSet& f, const std::optiona
     if (has_previous_) out.flags |= PoseEstimate::kRegistrationFailed;
   }
 
-  if (has_previous_) {
-    updateHeldVelocity(T, f.utime - previous_utime_, r.ok ? &r.result.information : nullptr);
-    last_motion_ = T;
+  if (has_previous_) {  // T is T_ref_curr
+    const Eigen::Isometry3d step = reference_kept_ ? ref_T_prev_.inverse() * T : T;
+    updateHeldVelocity(step, f.utime - previous_utime_, r.ok ? &r.result.information : nullptr);
+    last_motion_ = step;
     last_gap_us_ = f.utime - previous_utime_;
-    pose_ = pose_ * T;
+    pose_ = reference_pose_ * T;
   }
   out.pose = pose_;
-  // A compensated raw sweep counts as deskewed from now on.
-  setPrevious(cur, true);
-  previous_raw_ = cur_raw && !mixed;
+  reference_kept_ = has_previous_ && r.ok && !mixed && keepsReference(T);
+  if (reference_kept_) {
+    ref_T_prev_ = T;
+  } else {
+    // A compensated raw sweep counts as deskewed from now on.
+    setPrevious(cur, true);
+    previous_raw_ = cur_raw && !mixed;
+    ref_T_prev_ = Eigen::Isometry3d::Identity();
+    reference_pose_ = pose_;
+  }
   has_previous_ = true;
   previous_utime_ = f.utime;
   return out;

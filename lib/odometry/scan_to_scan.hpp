@@ -108,6 +108,15 @@ struct ScanToScanConfig {
   double startup_max_speed_mps = 30.0;
   double startup_search_step_m = 0.5;
   double startup_inlier_distance_m = 0.1;
+  // Reference sweep: a sweep is registered against the last sweep that moved the robot at least
+  // keep_reference_within_m or keep_reference_within_rad from the one before it, not always the previous
+  // sweep. At rest (or crawling) consecutive registrations each err by a few mm and a few hundredths of a
+  // degree (range noise, point selection) and scan-to-scan odometry sums those errors: 1-5 m in a minute
+  // standing still (issue 16). Against a kept reference each sweep's error stays that of one registration.
+  // Driving at 1.3 m/s (0.13 m a sweep) the reference is the previous sweep, as before. 0 = always the
+  // previous sweep (A-LOAM).
+  double keep_reference_within_m = 0.1;
+  double keep_reference_within_rad = 0.0175;
 };
 
 // Plain A-LOAM laserOdometry behaviour, for the "before vs after" ablation: motion-model seed only (LinK3D
@@ -175,6 +184,8 @@ class ScanToScanOdometry {
   // The last registration's least-observed translation direction (lidar frame; its degeneracy analysis),
   // whatever held it: a covariance held to the wheel no longer shows it.
   const Eigen::Vector3d& weakestTranslationDirection() const { return weakest_translation_; }
+  // True when the last sweep was registered against an earlier reference sweep kept at rest, not the previous one.
+  bool referenceKept() const { return reference_kept_; }
   void reset();
   // Starts over (no previous sweep, no velocity) but at `pose` instead of the identity: after a restart or a
   // gap in the input, the odometry frame continues where it was.
@@ -221,6 +232,12 @@ class ScanToScanOdometry {
   bool has_previous_ = false;
   std::int64_t previous_utime_ = 0;
   Eigen::Isometry3d pose_ = Eigen::Isometry3d::Identity();        // T_odom_lidar of the previous sweep
+  // The reference sweep (what previous_ indexes) as seen from the previous sweep's pose: identity when the
+  // reference is the previous sweep, T_ref_prev while a reference is kept (keep_reference_within_*).
+  Eigen::Isometry3d ref_T_prev_ = Eigen::Isometry3d::Identity();
+  Eigen::Isometry3d reference_pose_ = Eigen::Isometry3d::Identity();  // T_odom_lidar of the reference sweep
+  bool reference_kept_ = false;
+  bool keepsReference(const Eigen::Isometry3d& T_ref_curr) const;
   Eigen::Isometry3d last_motion_ = Eigen::Isometry3d::Identity();  // T_prev_curr of the previous step
   std::int64_t last_gap_us_ = 0;                                   // 0: no velocity estimate yet
   Vector6d held_velocity_ = Vector6d::Zero();  // averaged tangent velocity (per second), see predictHeldMotion

@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <limits>
 
@@ -98,6 +99,43 @@ TEST(ScanToScan, ConstantVelocityTracksASequence) {
   // Seven registrations (measured 0.29 deg accumulated).
   EXPECT_LT(translationError(odom.pose(), truth_end), 0.05);
   EXPECT_LT(rotationErrorDeg(odom.pose(), truth_end), 0.5);
+}
+
+// Standing still, each noisy sweep registered against the previous one adds its own error; against the
+// reference sweep kept while the robot has not moved (keep_reference_within_*) the error stays that of one
+// registration. Driving, the reference is the previous sweep.
+TEST(ScanToScan, AtRestTheReferenceSweepIsKeptAndErrorsDoNotAddUp) {
+  const auto world = test::boxRoom();
+  test::LidarModel noisy;
+  noisy.range_noise = 0.03;
+  const auto worstAtRest = [&](const ScanToScanConfig& config, bool* kept) {
+    ScanToScanOdometry odom(config);
+    double worst = 0.0;
+    for (int i = 0; i < 60; ++i) {
+      const PoseEstimate e = odom.process(test::simulateSweep(world, kStart, noisy, i * 100000, 100 + i));
+      worst = std::max(worst, translationError(Eigen::Isometry3d::Identity(), e.pose));
+      if (i > 0) *kept = *kept && odom.referenceKept();
+    }
+    return worst;
+  };
+  bool kept = true, kept_off = true;
+  const double with_reference = worstAtRest(ScanToScanConfig{}, &kept);
+  ScanToScanConfig previous_only;
+  previous_only.keep_reference_within_m = 0.0;
+  const double without = worstAtRest(previous_only, &kept_off);
+  std::printf("at rest, 60 noisy sweeps: worst %.2f mm against the kept reference, %.2f mm sweep to sweep\n",
+              1e3 * with_reference, 1e3 * without);
+  EXPECT_TRUE(kept);
+  EXPECT_FALSE(kept_off);
+  EXPECT_LT(with_reference, 0.5 * without);
+
+  ScanToScanOdometry driving;
+  const Eigen::Isometry3d step = test::poseFrom(0.2, 0.0, 0.0, 0.0, 0.0, 0.0);
+  Eigen::Isometry3d truth = kStart;
+  for (int i = 0; i < 4; ++i, truth = truth * step) {
+    driving.process(test::simulateSweep(world, truth, {}, i * 100000, 10 + i));
+    EXPECT_FALSE(driving.referenceKept()) << "sweep " << i;
+  }
 }
 
 TEST(ScanToScan, EmptyAndCorruptSweepsAreFlaggedNotFatal) {
