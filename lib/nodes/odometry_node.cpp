@@ -120,9 +120,11 @@ class OdometryNode : public runtime::Node {
       if (gyro_bias_.known()) {
         setCount("gyro_bias_stops", gyro_bias_.restPeriods());
         setCount("gyro_bias_mdeg_s", static_cast<std::int64_t>(std::lround(gyro_bias_.bias().norm() * 180e3 / M_PI)));
+        setCount("gyro_bias_sigma_mdeg_s", static_cast<std::int64_t>(std::lround(gyro_bias_.biasSigma() * 180e3 / M_PI)));
       }
     }
     if (pose.flags & PoseEstimate::kRegistrationFailed) count("registration_failed");
+    if (odometry_.referenceKept()) count("reference_kept");
     if (pose.flags & PoseEstimate::kDegenerateTranslation) {
       count("degenerate_translation");
       count(std::string("degenerate_along_") + "xyz"[nearestAxis(odometry_.weakestTranslationDirection())]);

@@ -3,6 +3,7 @@
 #include "core/geometry.hpp"
 
 #include <cmath>
+#include <limits>
 
 namespace adit {
 
@@ -18,6 +19,8 @@ const ConfigTable<GyroBiasConfig>& gyroBiasConfigTable() {
      .add("guard_s", &G::guard_s, atLeast(0), "s", "the newest part of a still period is not trusted until more follows")
      .add("time_constant_s", &G::time_constant_s, above(0), "s", "older still periods fade with this time constant")
      .add("max_bias_rad_s", &G::max_bias_rad_s, above(0), "rad/s", "a larger mean rate while still is refused as a bias")
+     .add("rocking_correlation_s", &G::rocking_correlation_s, atLeast(0), "s", "correlation time of the chassis' rocking at rest (a still period's slope variance: 12 r^2 this / L^3)")
+     .add("noise_density_rad_s_sqrt_hz", &G::noise_density_rad_s_sqrt_hz, above(0), "rad/s/sqrt(Hz)", "the gyro's white noise density (a still period's slope variance: this^2 / L)")
      .add("initial_sigma_rad_s", &G::initial_sigma_rad_s, atLeast(0), "rad/s", "the bias's sigma before a stop measured it (widens the gyro rotation's sigma)");
     return t;
   }();
@@ -40,11 +43,63 @@ void GyroBiasEstimator::observe(const std::vector<ImuSample>& imu, std::int64_t 
   if (!step_valid || !(translationNorm(step) < config_.rest_translation_m) ||
       !(turned < config_.rest_rotation_deg * M_PI / 180.0))
     return endPeriod();
-  if (period_.empty() && settled_.samples <= 0.0) period_start_ = t0;
+  if (period_.empty() && settled_.samples <= 0.0) {
+    period_start_ = t0;
+    theta_ = Eigen::Array3d::Zero();
+    last_sample_utime_ = t0;
+  }
+  integrate(imu, s);
   period_.push_back(s);
   if (accelerating()) return endPeriod();  // what was trusted stays in the estimate; window and guard are dropped
   update();
   settle();
+}
+
+// The angle the gyro turned since the period's start, sample by sample, into the interval's sums.
+void GyroBiasEstimator::integrate(const std::vector<ImuSample>& imu, Interval& s) {
+  for (const ImuSample& m : imu) {
+    if (!(m.utime > s.t0 && m.utime <= s.t1 && m.gyro.allFinite() && m.accel.allFinite())) continue;
+    theta_ += m.gyro.array() * toSeconds(m.utime - last_sample_utime_);
+    last_sample_utime_ = m.utime;
+    const double t = toSeconds(m.utime - period_start_);
+    s.t_sum += t;
+    s.t_sq_sum += t * t;
+    s.theta_sum += theta_;
+    s.theta_sq_sum += theta_ * theta_;
+    s.theta_t_sum += theta_ * t;
+  }
+}
+
+void GyroBiasEstimator::Interval::add(const Interval& o) {
+  rate_sum += o.rate_sum;
+  accel_sum += o.accel_sum;
+  samples += o.samples;
+  t_sum += o.t_sum;
+  t_sq_sum += o.t_sq_sum;
+  theta_sum += o.theta_sum;
+  theta_sq_sum += o.theta_sq_sum;
+  theta_t_sum += o.theta_t_sum;
+  t1 = o.t1;
+}
+
+// Least squares line theta = a + rate t. The residual is the rocking about the attitude the chassis rests
+// at, correlated over rocking_correlation_s rather than from sample to sample: its effect on the slope is
+// that of L / rocking_correlation_s independent samples.
+GyroBiasEstimator::Slope GyroBiasEstimator::fit(const Interval& sums, double length_s) const {
+  Slope out;
+  const double n = sums.samples;
+  const double sxx = sums.t_sq_sum - sums.t_sum * sums.t_sum / n;
+  if (!(n > 2.0) || !(sxx > 0.0) || !(length_s > 0.0)) {
+    out.variance = Eigen::Array3d::Constant(std::numeric_limits<double>::infinity());
+    return out;
+  }
+  const Eigen::Array3d sxy = sums.theta_t_sum - sums.theta_sum * (sums.t_sum / n);
+  const Eigen::Array3d syy = sums.theta_sq_sum - sums.theta_sum * sums.theta_sum / n;
+  out.rate = sxy / sxx;
+  const Eigen::Array3d residual_sq = ((syy - sxy * sxy / sxx) / n).max(0.0);
+  const double nd = config_.noise_density_rad_s_sqrt_hz;
+  out.variance = residual_sq * (12.0 * config_.rocking_correlation_s / (length_s * length_s * length_s)) + nd * nd / length_s;
+  return out;
 }
 
 // The intervals both before the acceleration window and older than the guard count the same way in every
@@ -54,11 +109,7 @@ void GyroBiasEstimator::settle() {
   const std::int64_t window_start = period_.back().t1 - toUtime(config_.window_s);
   const std::int64_t trusted_end = period_.back().t1 - toUtime(config_.guard_s);
   while (!period_.empty() && period_.front().t0 < window_start && period_.front().t1 <= trusted_end) {
-    const Interval& s = period_.front();
-    settled_.rate_sum += s.rate_sum;
-    settled_.accel_sum += s.accel_sum;
-    settled_.samples += s.samples;
-    settled_.t1 = s.t1;
+    settled_.add(period_.front());
     period_.pop_front();
   }
 }
@@ -78,36 +129,31 @@ bool GyroBiasEstimator::accelerating() const {
   return (recent / n_recent - before / n_before).norm() > config_.accel_tolerance_mps2;
 }
 
-// The period so far without its newest guard_s, blended with the estimate from before it. A period's mean
-// rate errs by the chassis' net rotation over it divided by its length (an idling engine rocks it by a
-// fraction of a degree) and by the gyro's noise: the first dominates, so a period weighs by its length
-// squared, inverse to that error's variance.
+// The period so far without its newest guard_s, its slope blended with the estimate from before it.
 void GyroBiasEstimator::update() {
   const std::int64_t trusted_end = period_.back().t1 - toUtime(config_.guard_s);
-  Eigen::Vector3d sum = settled_.rate_sum;
-  double samples = settled_.samples;
-  std::int64_t end = settled_.samples > 0.0 ? settled_.t1 : period_start_;
+  Interval trusted = settled_;
+  if (trusted.samples <= 0.0) trusted.t1 = period_start_;
   for (const Interval& s : period_) {
     if (s.t1 > trusted_end) break;
-    sum += s.rate_sum;
-    samples += s.samples;
-    end = s.t1;
+    trusted.add(s);
   }
-  const double length = toSeconds(end - period_start_);
-  if (samples <= 0.0 || length < config_.min_rest_s) return;
-  const Eigen::Vector3d mean = sum / samples;
-  if (!(mean.norm() <= config_.max_bias_rad_s)) return;
+  const double length = toSeconds(trusted.t1 - period_start_);
+  if (trusted.samples <= 0.0 || length < config_.min_rest_s) return;
+  const Slope slope = fit(trusted, length);
+  if (!(slope.rate.matrix().norm() <= config_.max_bias_rad_s) || !slope.variance.isFinite().all()) return;
   if (!counted_) {
     // A new period: what came before fades with the time since it was measured.
-    base_ = bias_;
-    base_weight_ = weight_ > 0.0 ? weight_ * std::exp(-toSeconds(period_start_ - base_utime_) / config_.time_constant_s) : 0.0;
+    base_ = mean_;
+    base_weight_ = periods_ > 0 ? Eigen::Array3d(weight_ * std::exp(-toSeconds(period_start_ - base_utime_) / config_.time_constant_s))
+                                : Eigen::Array3d::Zero();
     counted_ = true;
     ++periods_;
   }
-  const double weight = length * length;
+  const Eigen::Array3d weight = slope.variance.inverse();
   weight_ = base_weight_ + weight;
-  bias_ = (base_ * base_weight_ + mean * weight) / weight_;
-  base_utime_ = end;
+  mean_ = (base_ * base_weight_ + slope.rate * weight) / weight_;
+  base_utime_ = trusted.t1;
 }
 
 void GyroBiasEstimator::endPeriod() {
@@ -116,9 +162,25 @@ void GyroBiasEstimator::endPeriod() {
   counted_ = false;
 }
 
+// The turn-on bias: a prior of zero with sigma initial_sigma_rad_s, blended with the periods' slopes by
+// their weights (0 = no prior: the periods alone).
+double GyroBiasEstimator::priorWeight() const {
+  const double s = config_.initial_sigma_rad_s;
+  return s > 0.0 ? 1.0 / (s * s) : 0.0;
+}
+
+Eigen::Vector3d GyroBiasEstimator::bias() const {
+  if (!known()) return Eigen::Vector3d::Zero();
+  return (mean_ * weight_ / (weight_ + priorWeight())).matrix();
+}
+
+double GyroBiasEstimator::biasSigma() const {
+  if (!known()) return config_.initial_sigma_rad_s;
+  return 1.0 / std::sqrt((weight_ + priorWeight()).minCoeff());
+}
+
 double GyroBiasEstimator::rotationSigma(double sigma_rad, double interval_s) const {
-  if (known()) return sigma_rad;
-  const double bias = config_.initial_sigma_rad_s * interval_s;
+  const double bias = biasSigma() * interval_s;
   return std::sqrt(sigma_rad * sigma_rad + bias * bias);
 }
 

@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <random>
 
 namespace adit {
@@ -138,7 +139,30 @@ TEST(GyroBias, MeasuredWhileTheRobotStandsOnAnIdlingChassis) {
   EXPECT_EQ(estimator.restPeriods(), 1);
   // The rocking's net rotation over the period / its length, plus the noise: a few 1e-4 rad/s.
   EXPECT_LT((estimator.bias() - gyro.bias).norm(), 4e-4) << estimator.bias().transpose();
-  EXPECT_DOUBLE_EQ(estimator.rotationSigma(1e-4, 0.1), 1e-4);
+  // Known to ~1e-4 rad/s after 10 s: a sweep's rotation widened by ~1e-5 rad.
+  EXPECT_LT(estimator.biasSigma(), 2e-4);
+  EXPECT_NEAR(estimator.rotationSigma(1e-4, 0.1), 1e-4, 2e-6);
+}
+
+// Two seconds still on a chassis rocking 0.15 deg: the mean rate errs by the net rotation between the
+// period's ends over 2 s (up to ~2.6e-3 rad/s here); the slope fitted to the integrated angle does not, and
+// the estimate says how well it knows the bias.
+TEST(GyroBias, AShortStopOnARockingChassisIsFittedNotAveraged) {
+  for (const double phase_s : {0.0, 0.2, 0.4, 0.6}) {
+    GyroStream gyro;
+    GyroBiasEstimator estimator;
+    const std::int64_t start = toUtime(phase_s);
+    for (int k = 0; k < 25; ++k) {  // 2.5 s still: 2 s trusted behind the 0.5 s guard
+      const std::int64_t t0 = start + k * 100000, t1 = t0 + 100000;
+      estimator.observe(gyro.interval(t0, t1, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()), t0, t1, stepOf(0.01), true);
+    }
+    ASSERT_TRUE(estimator.known());
+    const double error = (estimator.bias() - gyro.bias).norm();
+    std::printf("phase %.1f s: bias error %.2e rad/s, sigma %.2e\n", phase_s, error, estimator.biasSigma());
+    EXPECT_LT(error, 8e-4) << estimator.bias().transpose();
+    EXPECT_LT(error, 3.0 * estimator.biasSigma() * std::sqrt(3.0));
+    EXPECT_GT(estimator.biasSigma(), 1e-4);  // a short stop is not trusted like a long one
+  }
 }
 
 TEST(GyroBias, UnknownUntilTheRobotStops) {
