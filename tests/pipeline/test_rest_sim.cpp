@@ -1,11 +1,10 @@
 // A robot standing still (issue 16, item 1): 60 s at rest in every simulated world (sim.motion.stationary),
 // once with an exact lidar and IMU and no vibration, once with the sensors' noise and the chassis vibrating
 // (engine idling, sim.motion.idle_vibration). What the estimate does there is a bias, nothing else. The issue's
-// targets (ODOM_SCAN within 1 cm and 0.05 deg, the pipeline within 5 mm) are not reached (README, "Bias at
-// rest"): ODOM_SCAN's rotation is held to what it measures with the gyro weighed, its translation is printed,
-// not asserted (it drifts 0.4-5 m in 60 s with the default less-flat centroids; exactly 0 with exact sensors
-// and features.loam.less_flat_measured + odometry.plane_through_nearest); the pipeline is held to what it
-// measures, with margin.
+// targets: ODOM_SCAN within 1 cm and 0.05 deg, the pipeline within 5 mm. With exact sensors ODOM_SCAN meets
+// them but for room-and-pillar's translation (16 mm); with noise and vibration it does not (36-70 mm, 0.5-0.9
+// deg), nor does the pipeline (5-16 mm exact, 18-41 mm noisy): README, "Bias at rest". Each is held to what
+// it measures, with margin.
 #include "sim_pipeline.hpp"
 
 #include <gtest/gtest.h>
@@ -57,10 +56,13 @@ void expectAtRest(const std::string& world, bool noisy) {
   std::printf("%-16s %-6s at rest %.0f s: scan-to-scan %.2f mm %.4f deg, pipeline %.2f mm %.4f deg\n",
               world.c_str(), noisy ? "noisy" : "exact", kRestSeconds, 1e3 * scan.metres, scan.degrees,
               1e3 * full.metres, full.degrees);
-  // ODOM_SCAN's rotation, with the gyro weighed (odometry.gyro_rotation_sigma_rad; its bias measured while the
-  // robot stands): exact 0.06, 0.16, 0.31, 0.05 deg (loop, straight, room-and-pillar, featureless; before
-  // 1.7-21 deg), noisy 2.6-2.8 deg (before 18-55 deg). Its translation is not held (0.4-5 m).
-  EXPECT_LT(scan.degrees, noisy ? 4.0 : 0.5) << world << (noisy ? " noisy" : " exact");
+  // ODOM_SCAN, registered against the sweep it last moved from (odometry.keep_reference_within_*), the gyro
+  // weighed with its bias fitted while the robot stands: exact 5.7 / 3.8 / 15.8 / 2.9 mm, 0.005 / 0.022 /
+  // 0.044 / 0.039 deg (loop, straight, room-and-pillar, featureless; every sweep against the previous one:
+  // 0.4-3.8 m, 0.05-0.31 deg); noisy 46 / 61 / 36 / 70 mm, 0.55 / 0.95 / 0.67 / 0.87 deg (before 1.3-5.2 m,
+  // 2.6-2.8 deg).
+  EXPECT_LT(scan.metres, noisy ? 0.15 : 0.025) << world << (noisy ? " noisy" : " exact");
+  EXPECT_LT(scan.degrees, noisy ? 1.5 : 0.07) << world << (noisy ? " noisy" : " exact");
   // Measured, exact: 16.3 mm / 0.26 deg (roadway-loop: the mapper's first second), 3.9, 1.9, 6.4 mm.
   EXPECT_LT(full.metres, noisy ? kNoisyPipelineMetres : 0.025) << world << (noisy ? " noisy" : " exact");
   EXPECT_LT(full.degrees, noisy ? kNoisyPipelineDegrees : 0.4) << world << (noisy ? " noisy" : " exact");
@@ -106,10 +108,11 @@ TEST(ScanDriftSim, RoadwayLoopScanToScanAlone) {
               "%.2f deg; mapped %.3f m (%.2f %%)\n", seconds, distance, scan_error, 100 * scan_error / distance,
               scan_path, 100 * (scan_path / distance - 1), rotationAngle(truth.inverse() * scan) * 180 / M_PI,
               mapped_error, 100 * mapped_error / distance);
-  // Measured 1.72 % (2.6 m over 150 m; 3.68 % and 4.26 % with seeds 2 and 3), heading 2.9 deg off at the end.
-  // Before the gyro weighed the rotation (odometry.gyro_rotation_sigma_rad): 3.12 % here, heading 22.9 deg
-  // off (11-12 deg with seeds 2 and 3). What is left is translation: the estimate climbs 3-5 mm a sweep (edge
-  // lines, README "Bias at rest"). The issue's target is 2 %.
+  // Measured 2.03 % (3.0 m over 150 m; 3.25 % and 3.69 % with seeds 2 and 3), heading 3.3 deg off at the end
+  // (the gyro's bias fitted at stops; with its mean rate instead: 1.72 / 3.68 / 4.26 %). Before the gyro
+  // weighed the rotation (odometry.gyro_rotation_sigma_rad): 3.12 % here, heading 22.9 deg off (11-12 deg
+  // with seeds 2 and 3). What is left is translation: the estimate climbs 3-5 mm a sweep (edge lines, README
+  // "Bias at rest"). The issue's target is 2 %.
   EXPECT_LT(scan_error, 0.05 * distance);
   EXPECT_LT(rotationAngle(truth.inverse() * scan) * 180 / M_PI, 6.0);
 }
