@@ -420,11 +420,12 @@ PoseEstimate ScanToScanOdometry::process(const FeatureSet& f, const std::optiona
     pose_ = reference_pose_ * T;
   }
   out.pose = pose_;
-  reference_kept_ = has_previous_ && r.ok && !mixed && keepsReference(T);
+  // A compensated raw sweep counts as deskewed from now on (a reference kept after its compensation too).
+  reference_kept_ = has_previous_ && r.ok && keepsReference(T);
   if (reference_kept_) {
     ref_T_prev_ = T;
+    previous_raw_ = previous_raw_ && !mixed;
   } else {
-    // A compensated raw sweep counts as deskewed from now on.
     setPrevious(cur, true);
     previous_raw_ = cur_raw && !mixed;
     ref_T_prev_ = Eigen::Isometry3d::Identity();
