@@ -41,13 +41,14 @@ struct ScanToScanConfig {
   // to all of them and must pass the checks above, instead of A-LOAM's line through the nearest point and the
   // closest point on another ring; an edge only two rings see keeps that two-point line. On a 16-beam lidar a
   // two-point line is often a chord of a curved edge (an arch rib, a rock crest: 17 cm between rings at 5 m),
-  // and a point matched to a chord is pulled off its edge. Measured (roadway-loop 120 s, seeds 1-3, gyro
-  // weighed), scan-to-scan end-point drift: two-point lines 1.72 / 3.68 / 4.26 %, the estimate climbing 3-5 mm
-  // a sweep; with this 2.45 / 1.43 / 2.16 %, a 10 s lidar stall's motion 0.10 -> 0.04 m, the mapped APE 0.0648
-  // -> 0.0643 m. Off: the 12 s demo's map against the simulated world got worse, 0.022 -> 0.035 m mean and
-  // 0.067 -> 0.086 m at the 95th percentile (README, "Bias at rest"). line_min_rings 3 (no two-point lines at
-  // all: 2.54 / 1.23 / 2.23 %) put the stall's motion 0.47 m off.
-  bool line_through_all_rings = false;
+  // and a point matched to a chord is pulled off its edge: the estimate climbed 3-5 mm a sweep. Measured
+  // (roadway-loop 120 s, seeds 1-3, with the reference kept at rest and the gyro's bias fitted), scan-to-scan
+  // end-point drift: two-point lines 2.03 / 3.25 / 3.69 %, this 2.40 / 1.41 / 1.82 % (mean 2.99 -> 1.88 %);
+  // the mapped APE 0.0642 -> 0.0650 m on seed 1 and its map against the world 0.0234 -> 0.0223 m mean;
+  // kitti_mini 00 / 01 / 02 0.3107 / 0.0356 / 0.0249 -> 0.3115 / 0.0345 / 0.0211 m; the 12 s demo's map
+  // 0.020 -> 0.026 m mean (session 15 found that and kept it off). line_min_rings 3 (no two-point lines at
+  // all) put a 10 s lidar stall's motion 0.47 m off.
+  bool line_through_all_rings = true;
   double line_eigen_ratio = 3.0;
   double line_max_point_distance_m = 0.1;
   // Planes are fitted (least squares) to the plane_neighbours nearest previous less-flat points plus the

@@ -35,11 +35,18 @@ MapperConfig kittiMapperConfig() {
   return m;
 }
 
+// 64-beam odometry: A-LOAM's two-point edge lines (as launch/sensors/hdl64.yaml).
+ScanToScanConfig kittiOdometryConfig() {
+  ScanToScanConfig o;
+  o.line_through_all_rings = false;
+  return o;
+}
+
 PairErrors runSequence(const std::string& name, bool aloam) {
   const io::KittiSequence seq = io::KittiSequence::open(kRoot, name);
   const Trajectory gt = seq.groundTruthLidar(seq.defaultPosesFile());
   const FeatureExtractor fx{FeatureConfig{}};
-  ScanToScanOdometry odom(aloam ? aloamOdometryConfig() : ScanToScanConfig{});
+  ScanToScanOdometry odom(aloam ? aloamOdometryConfig() : kittiOdometryConfig());
   MapperConfig mc = kittiMapperConfig();
   if (aloam) mc.registration.degeneracy_prior = false, mc.compensate_raw_sweeps = false;
   ScanToMapMapper mapper(mc);
