@@ -71,7 +71,6 @@ void GyroBiasEstimator::integrate(const std::vector<ImuSample>& imu, Interval& s
 }
 
 void GyroBiasEstimator::Interval::add(const Interval& o) {
-  rate_sum += o.rate_sum;
   accel_sum += o.accel_sum;
   samples += o.samples;
   t_sum += o.t_sum;

@@ -81,7 +81,8 @@ class GyroBiasEstimator {
   // Sums over an interval's samples; t (s) and the integrated angle theta (rad) count from the period's start.
   struct Interval {
     std::int64_t t0 = 0, t1 = 0;
-    Eigen::Vector3d rate_sum = Eigen::Vector3d::Zero(), accel_sum = Eigen::Vector3d::Zero();
+    Eigen::Vector3d rate_sum = Eigen::Vector3d::Zero();  // this interval only: how far the gyro turned
+    Eigen::Vector3d accel_sum = Eigen::Vector3d::Zero();
     double samples = 0.0;
     double t_sum = 0.0, t_sq_sum = 0.0;
     Eigen::Array3d theta_sum = Eigen::Array3d::Zero(), theta_sq_sum = Eigen::Array3d::Zero(),
