@@ -34,6 +34,7 @@ MapperConfig aloamMapperConfig() {
   m.registration.max_solver_iterations = 4;
   m.registration.reuse_match_distance_m = 0.0;  // A-LOAM searches every round afresh
   m.plane_through_nearest = false;
+  m.thin_within_sweep = true;
   return m;
 }
 
@@ -52,6 +53,7 @@ const ConfigTable<MapperConfig>& mapperConfigTable() {
      .add("line_eigen_ratio", &M::line_eigen_ratio, atLeast(1), "", "edge if the largest eigenvalue exceeds ratio * the second (A-LOAM: 3)")
      .add("plane_max_point_distance_m", &M::plane_max_point_distance_m, above(0), "m", "a plane is rejected if a neighbour is farther (A-LOAM: 0.2)")
      .add("plane_through_nearest", &M::plane_through_nearest, anyValue(), "", "a surface match's plane passes through the nearest map point, not the neighbours' centroid (A-LOAM: false)")
+     .add("thin_within_sweep", &M::thin_within_sweep, anyValue(), "", "a sweep's points are also thinned against each other as they enter the local map, not only against earlier sweeps (A-LOAM; 64 beams)")
      .add("local_map_radius_m", &M::local_map_radius_m, above(0), "m", "map points farther from the robot are dropped (bounds memory)")
      .add("global_map_resolution_m", &M::global_map_resolution_m, between(0.01, 100), "m", "resolution of the saved global map")
      .add("global_map_max_range_m", &M::global_map_max_range_m, above(0), "m", "range of the sweep points folded into the global map")
@@ -128,8 +130,8 @@ void ScanToMapMapper::compensate(Sweep& s, const Eigen::Isometry3d& T_prev_curr,
 }
 
 void ScanToMapMapper::addToMaps(const Sweep& s, const Eigen::Isometry3d& T) {
-  corner_map_.insert(transformed(s.corner_points, T));
-  surf_map_.insert(transformed(s.surf_points, T));
+  corner_map_.insert(transformed(s.corner_points, T), config_.thin_within_sweep);
+  surf_map_.insert(transformed(s.surf_points, T), config_.thin_within_sweep);
   corner_map_.removeFarFrom(T.translation(), config_.local_map_radius_m);
   surf_map_.removeFarFrom(T.translation(), config_.local_map_radius_m);
   if (!keep_global_map_) return;

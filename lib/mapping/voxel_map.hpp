@@ -25,7 +25,9 @@ class VoxelMap {
   // than this to a point of its voxel is dropped (map resolution). max_points_per_voxel bounds density.
   VoxelMap(double voxel_size, double min_spacing, int max_points_per_voxel);
 
-  void insert(const std::vector<Eigen::Vector3d>& points);
+  // Adds the points, each unless closer than min_spacing to a point its voxel held before this call (or, with
+  // thin_among_them, also to one added by this call before it) or its voxel is full.
+  void insert(const std::vector<Eigen::Vector3d>& points, bool thin_among_them = false);
   // Drops every voxel whose centre is farther than radius from centre.
   void removeFarFrom(const Eigen::Vector3d& centre, double radius);
   // Moves every point by T (a loop-closure correction) and re-hashes.

@@ -212,3 +212,29 @@ TEST(VoxelMap, QueriesMatchABruteForceSearchThroughInsertionsAndRemovals) {
     }
   }
 }
+
+// The spacing thins a new sweep against what the map already holds, never a sweep's points against each other:
+// they were thinned by their own grid, and a point dropped there left the next sweep's copy of it to match a
+// neighbour on a curved wall (the mapper moved 15 mm at rest).
+TEST(VoxelMap, SpacingThinsAgainstEarlierInsertsOnly) {
+  adit::VoxelMap map(1.0, 0.4, 20);
+  const std::vector<Eigen::Vector3d> sweep = {{0.1, 0.1, 0.1}, {0.3, 0.1, 0.1}, {0.55, 0.1, 0.1}, {2.5, 0.5, 0.5}};
+  map.insert(sweep);
+  EXPECT_EQ(map.numPoints(), 4u);  // 0.2-0.25 m apart in one voxel, all kept
+  // The same points again, one of them nudged, and a new one 0.44 m from the nearest: only that one is added.
+  map.insert({{0.1, 0.1, 0.1}, {0.31, 0.1, 0.1}, {0.99, 0.1, 0.1}});
+  EXPECT_EQ(map.numPoints(), 5u);
+  for (const Eigen::Vector3d& p : sweep) {
+    const std::vector<Eigen::Vector3d> near = map.nearest(p, 1, 1.0);
+    ASSERT_EQ(near.size(), 1u);
+    EXPECT_EQ(near.front(), p);  // every point of the first sweep finds itself
+  }
+  // The density bound still holds within one insert.
+  adit::VoxelMap capped(1.0, 0.01, 3);
+  capped.insert({{0.1, 0.1, 0.1}, {0.2, 0.1, 0.1}, {0.3, 0.1, 0.1}, {0.4, 0.1, 0.1}, {0.5, 0.1, 0.1}});
+  EXPECT_EQ(capped.numPoints(), 3u);
+  // mapping.thin_within_sweep (64 beams): the points of one insert are thinned against each other too.
+  adit::VoxelMap within(1.0, 0.4, 20);
+  within.insert(sweep, true);
+  EXPECT_EQ(within.numPoints(), 3u);  // 0.3 lies within 0.4 m of 0.1
+}

@@ -2,8 +2,9 @@
 // once with an exact lidar and IMU and no vibration, once with the sensors' noise and the chassis vibrating
 // (engine idling, sim.motion.idle_vibration). What the estimate does there is a bias, nothing else. The issue's
 // targets: ODOM_SCAN within 1 cm and 0.05 deg, the pipeline within 5 mm. With exact sensors ODOM_SCAN meets
-// them in every world; with noise and vibration it does not (44-87 mm, 0.8-1.0 deg), nor does the pipeline
-// (5-16 mm exact, 17-40 mm noisy): README, "Bias at rest". Each is held to what it measures, with margin.
+// them in every world; with noise and vibration it does not (44-87 mm, 0.8-1.0 deg); the pipeline meets 5 mm
+// exact in three worlds of four (6.1 mm on roadway-loop), not noisy (19-43 mm): README, "Bias at rest". Each
+// is held to what it measures, with margin.
 #include "sim_pipeline.hpp"
 
 #include <gtest/gtest.h>
@@ -14,7 +15,7 @@ namespace adit {
 namespace {
 
 constexpr double kRestSeconds = 60.0;
-// Measured, noisy: 37.8 mm / 0.71 deg (roadway-loop), 35.8 / 0.32, 20.9 / 0.20, 22.7 mm / 0.35 deg.
+// Measured, noisy: 25.5 mm / 0.57 deg (roadway-loop), 27.6 / 0.40, 19.4 / 0.32, 42.9 mm / 0.63 deg.
 constexpr double kNoisyPipelineMetres = 0.06, kNoisyPipelineDegrees = 1.0;
 
 struct RestError {
@@ -62,8 +63,9 @@ void expectAtRest(const std::string& world, bool noisy) {
   // 2.6-2.8 deg).
   EXPECT_LT(scan.metres, noisy ? 0.15 : 0.015) << world << (noisy ? " noisy" : " exact");
   EXPECT_LT(scan.degrees, noisy ? 1.5 : 0.05) << world << (noisy ? " noisy" : " exact");
-  // Measured, exact: 16.3 mm / 0.26 deg (roadway-loop: the mapper's first second), 3.9, 1.9, 6.4 mm.
-  EXPECT_LT(full.metres, noisy ? kNoisyPipelineMetres : 0.025) << world << (noisy ? " noisy" : " exact");
+  // Measured, exact: 6.1 / 2.8 / 4.4 / 1.9 mm, 0.03 / 0.10 / 0.01 / 0.03 deg; 16.3 / 6.0 / 5.3 / 5.4 mm while
+  // the local map thinned a sweep's own points against each other (VoxelMap::insert).
+  EXPECT_LT(full.metres, noisy ? kNoisyPipelineMetres : 0.010) << world << (noisy ? " noisy" : " exact");
   EXPECT_LT(full.degrees, noisy ? kNoisyPipelineDegrees : 0.4) << world << (noisy ? " noisy" : " exact");
 }
 
