@@ -168,6 +168,7 @@ void LoopCloser::applyDue(std::int64_t utime, bool all, Result& result) {
     stats_.rejected_degenerate += c.rejected_degenerate;
     stats_.rejected_odometry += c.rejected_odometry;
     stats_.rejected_pairwise += c.rejected_pairwise;
+    stats_.contested += c.contested;
     stats_.accepted += c.accepted;
     stats_.partial_loops += c.partial_loops;
     stats_.keypoint_seeds += c.keypoint_seeds;

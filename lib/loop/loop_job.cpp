@@ -1,5 +1,7 @@
 #include "loop/loop_job.hpp"
 
+#include "loop/loop_consensus.hpp"
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -176,16 +178,11 @@ class JobRun {
     auto& pending = book_.pending;
     pending.erase(std::remove_if(pending.begin(), pending.end(), [&](const LoopConstraint& p) { return !near(p); }),
                   pending.end());
-    std::vector<LoopConstraint> group;
-    std::vector<LoopConstraint> rest;
-    for (const LoopConstraint& p : pending) (pairConsistent(p, loop) ? group : rest).push_back(p);
-    if (static_cast<int>(group.size()) + 1 >= config_.min_consistent_loops) {
-      group.push_back(loop);
-      pending = rest;
-      return group;
-    }
-    pending.push_back(loop);
-    return {};
+    const LoopsAgree agree = [this](const LoopConstraint& a, const LoopConstraint& b) { return pairConsistent(a, b); };
+    LoopConsensus c = seekConsensus(pending, loop, config_.min_consistent_loops, agree);
+    if (c.contested) ++counts_.contested;
+    pending = std::move(c.pending);
+    return std::move(c.accepted);
   }
 
   // The snapshot's graph with every accepted loop the main thread had not applied yet (this job's and those

@@ -170,6 +170,7 @@ class LoopCloserNode : public runtime::Node, public WritesProducts, public Write
     setCount("keypoint_seeds", s.keypoint_seeds);
     setCount("keypoint_loops", s.keypoint_loops);
     setCount("rejected_ambiguous", s.rejected_ambiguous);
+    setCount("contested", s.contested);
     setCount("rejected_fitness", s.rejected_fitness);
     setCount("rejected_degenerate", s.rejected_degenerate);
     setCount("rejected_odometry_gate", s.rejected_odometry);

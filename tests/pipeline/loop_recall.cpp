@@ -55,10 +55,10 @@ int main(int argc, char** argv) {
       return it == run.loop_counters.end() ? std::int64_t{0} : it->second;
     };
     fmt::print(stderr, "{} {} s seed {}: candidates {}, rejected fitness {} degenerate {} odometry {} pairwise {}; "
-               "LinK3D seeds {}, fits found only from them {}, refused as ambiguous {}\n", world, seconds, seed,
+               "LinK3D seeds {}, fits found only from them {}, refused as ambiguous {}; contested {}\n", world, seconds, seed,
                counter("loop_candidates"), counter("rejected_fitness"), counter("rejected_degenerate"),
                counter("rejected_odometry_gate"), counter("rejected_pairwise"), counter("keypoint_seeds"),
-               counter("keypoint_loops"), counter("rejected_ambiguous"));
+               counter("keypoint_loops"), counter("rejected_ambiguous"), counter("contested"));
   }
   return 0;
 }
