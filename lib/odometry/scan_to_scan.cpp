@@ -299,6 +299,23 @@ ScanToScanOdometry::Refinement ScanToScanOdometry::searchStart(const SweepPoints
   return best;
 }
 
+namespace {
+
+// Rotation block of the inverse of the lidar's information plus the gyro prior's (and the motion model's weak
+// translation prior, which keeps the inverse defined where the lidar leaves a translation unobserved).
+Eigen::Matrix3d fusedRotationCovariance(const Matrix6d& lidar_information, const RotationPrior& gyro,
+                                        const RegistrationConfig& c) {
+  Matrix6d info = 0.5 * (lidar_information + lidar_information.transpose());
+  if (!info.allFinite()) info.setZero();
+  info.bottomRightCorner<3, 3>() += rotationPriorInformation(gyro);
+  info.topLeftCorner<3, 3>() += Eigen::Matrix3d::Identity() / (c.prior_sigma_translation_m * c.prior_sigma_translation_m);
+  const Matrix6d covariance = info.ldlt().solve(Matrix6d::Identity());
+  const Eigen::Matrix3d rotation = covariance.bottomRightCorner<3, 3>();
+  return rotation.allFinite() ? Eigen::Matrix3d(0.5 * (rotation + rotation.transpose())) : Eigen::Matrix3d::Zero();
+}
+
+}  // namespace
+
 bool ScanToScanOdometry::keepsReference(const Eigen::Isometry3d& T_ref_curr) const {
   return config_.keep_reference_within_m > 0.0 && config_.keep_reference_within_rad > 0.0 &&
          T_ref_curr.translation().norm() < config_.keep_reference_within_m &&
@@ -356,10 +373,16 @@ PoseEstimate ScanToScanOdometry::process(const FeatureSet& f, const std::optiona
   // (the previous one, or an earlier one kept while the robot barely moves: keep_reference_within_*). The
   // gyro's step is added to the estimated T_ref_prev, not integrated since the reference: its bias error
   // then never adds up, and the weighing acts as a complementary filter of gyro and lidar.
+  // The step's prior is then as uncertain as that estimate plus the step (a Kalman prediction): were it held
+  // to the step's sigma alone, the lidar could correct the gyro's bias error only at the rate of the ratio of
+  // the two informations, and an idling robot's roll and pitch walked 0.6 deg in a minute.
   if (reference_kept_) {
     seed = ref_T_prev_ * seed;
     hold = ref_T_prev_ * hold;
-    if (gyro) gyro->R = ref_T_prev_.linear() * gyro->R;
+    if (gyro) {
+      gyro->R = ref_T_prev_.linear() * gyro->R;
+      gyro->covariance = ref_R_prev_covariance_;
+    }
   }
   // Before a velocity is known the motion model says nothing (its identity is not "standing still"):
   // holding a degenerate direction to it would pin the estimate at zero motion.
@@ -398,10 +421,13 @@ PoseEstimate ScanToScanOdometry::process(const FeatureSet& f, const std::optiona
   }
   out.iterations = r.iterations;
   Eigen::Isometry3d T = r.pose;
+  Eigen::Matrix3d rotation_covariance = Eigen::Matrix3d::Zero();  // of T_ref_curr's rotation, lidar and gyro
   if (has_previous_ && r.ok) {
     RegistrationConfig reported = config_.registration;
     if (held_to_measured) reported.prior_sigma_translation_m = measured->sigma_translation_m;
     reportRegistration(r.result, reported, out);
+    rotation_covariance = gyro ? fusedRotationCovariance(r.result.information, *gyro, reported)
+                               : Eigen::Matrix3d(out.covariance.bottomRightCorner<3, 3>());
     weakest_translation_ = r.result.degeneracy.translation_directions.col(0);
     if (held_to_measured && (r.result.degeneracy.flags & PoseEstimate::kDegenerateTranslation))
       out.flags |= kPoseHeldToWheel;
@@ -424,8 +450,10 @@ PoseEstimate ScanToScanOdometry::process(const FeatureSet& f, const std::optiona
   reference_kept_ = has_previous_ && r.ok && keepsReference(T);
   if (reference_kept_) {
     ref_T_prev_ = T;
+    ref_R_prev_covariance_ = rotation_covariance;
     previous_raw_ = previous_raw_ && !mixed;
   } else {
+    ref_R_prev_covariance_.setZero();
     setPrevious(cur, true);
     previous_raw_ = cur_raw && !mixed;
     ref_T_prev_ = Eigen::Isometry3d::Identity();

@@ -237,6 +237,9 @@ class ScanToScanOdometry {
   // reference is the previous sweep, T_ref_prev while a reference is kept (keep_reference_within_*).
   Eigen::Isometry3d ref_T_prev_ = Eigen::Isometry3d::Identity();
   Eigen::Isometry3d reference_pose_ = Eigen::Isometry3d::Identity();  // T_odom_lidar of the reference sweep
+  // Covariance of ref_T_prev_'s rotation as estimated (rad^2; zero when the reference is the previous sweep):
+  // the gyro's step starts from that estimate, so the step's prior is no surer than it.
+  Eigen::Matrix3d ref_R_prev_covariance_ = Eigen::Matrix3d::Zero();
   bool reference_kept_ = false;
   bool keepsReference(const Eigen::Isometry3d& T_ref_curr) const;
   Eigen::Isometry3d last_motion_ = Eigen::Isometry3d::Identity();  // T_prev_curr of the previous step

@@ -5,6 +5,7 @@
 #include "registration/robust_loss.hpp"
 
 #include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
 
 #include <algorithm>
 #include <cmath>
@@ -104,10 +105,21 @@ void addRotationPrior(const RotationPrior& prior, const Eigen::Isometry3d& T0, c
                       std::vector<DirectionalPrior>& priors) {
   const Eigen::AngleAxisd aa(T0.linear().transpose() * prior.R);
   const Eigen::Vector3d phi = aa.angle() * aa.axis();
+  if (prior.covariance.isZero()) {  // isotropic: one prior per axis
+    for (int i = 0; i < 3; ++i) {
+      Vector6d v = Vector6d::Zero();
+      v[3 + i] = 1.0;
+      priors.push_back({v, c.point_sigma_m / prior.sigma_rad, phi[i]});
+    }
+    return;
+  }
+  // One prior per principal direction of the information (weights in the solver's units: point_sigma / sigma).
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(rotationPriorInformation(prior));
   for (int i = 0; i < 3; ++i) {
+    const Eigen::Vector3d u = eig.eigenvectors().col(i);
     Vector6d v = Vector6d::Zero();
-    v[3 + i] = 1.0;
-    priors.push_back({v, c.point_sigma_m / prior.sigma_rad, phi[i]});
+    v.tail<3>() = u;
+    priors.push_back({v, c.point_sigma_m * std::sqrt(std::max(0.0, eig.eigenvalues()[i])), u.dot(phi)});
   }
 }
 
@@ -197,6 +209,11 @@ ConfigTable<RegistrationConfig> registrationConfigTable(const std::string& prefi
    .add("search_threads", &G::search_threads, between(1, 64), "threads", "threads of the correspondence search (same result for any count)")
    .add("reuse_match_distance_m", &G::reuse_match_distance_m, atLeast(0), "m", "a query that moved less than this since its last search in the sweep keeps that match (0: search every round)");
   return t;
+}
+
+Eigen::Matrix3d rotationPriorInformation(const RotationPrior& prior) {
+  const Eigen::Matrix3d c = prior.sigma_rad * prior.sigma_rad * Eigen::Matrix3d::Identity() + prior.covariance;
+  return (0.5 * (c + c.transpose())).ldlt().solve(Eigen::Matrix3d::Identity());
 }
 
 RegistrationResult registerStep(const Correspondences& matches, const Eigen::Isometry3d& T0,

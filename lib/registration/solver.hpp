@@ -78,11 +78,16 @@ struct RegistrationResult {
 };
 
 // A rotation measured by another sensor (a gyro integrated over the sweep interval): T's rotation is held
-// to R with a standard deviation of sigma_rad about each axis, beside the point residuals.
+// to R with a standard deviation of sigma_rad about each axis, beside the point residuals. `covariance` adds
+// the uncertainty of what R was integrated from (rad^2, sweep-frame tangent): an earlier estimate, when the
+// reference sweep is not the previous one.
 struct RotationPrior {
   Eigen::Matrix3d R = Eigen::Matrix3d::Identity();  // reference_R_sweep
   double sigma_rad = 1e-3;
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
 };
+// The prior's information (1/rad^2): the inverse of sigma_rad^2 I + covariance.
+Eigen::Matrix3d rotationPriorInformation(const RotationPrior& prior);
 
 // Solves for the pose T (reference_T_sweep) starting at T0. `motion_prior` is the motion model's guess of T,
 // used only along degenerate directions; `rotation_prior` (optional) weighs T's rotation in every direction.
