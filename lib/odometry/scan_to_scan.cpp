@@ -364,9 +364,12 @@ PoseEstimate ScanToScanOdometry::process(const FeatureSet& f, const std::optiona
   const bool imu_prior = prior_usable && (prior_flags & PoseEstimate::kSeededByImu) != 0;
   // A measured motion (wheel odometry) observes what the lidar cannot: hold to it first.
   const bool held_to_measured = measured && isFinitePose(measured->T_prev_curr);
-  Eigen::Isometry3d hold = held_to_measured ? measured->T_prev_curr
-                           : imu_prior      ? *prior
-                                            : predictHeldMotion(f.utime);
+  // With an IMU the degenerate translation holds the same averaged velocity as without one (the IMU's
+  // translation is the last step, as noisy as the sweep it came from), until there is none: then the prior's.
+  Eigen::Isometry3d hold = held_to_measured                     ? measured->T_prev_curr
+                           : imu_prior && !hasVelocity(f.utime) ? *prior
+                                                                : predictHeldMotion(f.utime);
+  if (!held_to_measured && imu_prior) hold.linear() = prior->linear();
   // A weighed gyro is what a degenerate rotation (the roll of a round roadway) holds to.
   if (gyro) hold.linear() = gyro->R;
   // All of the above is over the interval prev -> curr; the registration's target is the reference sweep
