@@ -178,8 +178,8 @@ class JobRun {
     auto& pending = book_.pending;
     pending.erase(std::remove_if(pending.begin(), pending.end(), [&](const LoopConstraint& p) { return !near(p); }),
                   pending.end());
-    const LoopsAgree agree = [this](const LoopConstraint& a, const LoopConstraint& b) { return pairConsistent(a, b); };
-    LoopConsensus c = seekConsensus(pending, loop, config_.min_consistent_loops, agree);
+    const auto agree = [this](const LoopConstraint& a, const LoopConstraint& b) { return pairConsistent(a, b); };
+    Consensus<LoopConstraint> c = seekConsensus(pending, loop, config_.min_consistent_loops, agree);
     if (c.contested) ++counts_.contested;
     pending = std::move(c.pending);
     return std::move(c.accepted);

@@ -1,6 +1,7 @@
 #include "map/relocaliser.hpp"
 
 #include "core/geometry.hpp"
+#include "loop/loop_consensus.hpp"
 #include "loop/odometry_chain.hpp"
 #include "loop/place_match.hpp"
 #include "loop/se3.hpp"
@@ -166,15 +167,12 @@ void Relocaliser::relocalise(const PoseEstimate& session, Result& result) {
                  pending_.end());
   fruitless_queries_ = fix ? 0 : fruitless_queries_ + 1;
   if (!fix) return;
-  int agreeing = 1;
-  bool any_disagree = false;
-  for (const Fix& p : pending_) {
-    if (consistent(p, *fix)) ++agreeing;
-    else any_disagree = true;
-  }
-  if (agreeing < config_.min_consistent_fixes) {
-    if (any_disagree) ++stats_.rejected_inconsistent;
-    pending_.push_back(*fix);
+  // A fix agreed by enough queries and by more than contradict them (see loop/loop_consensus.hpp).
+  Consensus<Fix> c = seekConsensus(pending_, *fix, config_.min_consistent_fixes,
+                                   [this](const Fix& a, const Fix& b) { return consistent(a, b); });
+  if (c.accepted.empty()) {
+    if (c.contradicted) ++stats_.rejected_inconsistent;
+    pending_ = std::move(c.pending);
     return;
   }
   T_map_session_ = orthonormal(bundle_.keyframes[static_cast<std::size_t>(fix->match)].pose * fix->T_match_query *

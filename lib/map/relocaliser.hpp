@@ -7,7 +7,8 @@
 // steps (loop/place_match.hpp) and acceptance tests (tight fit, all 6 directions constrained). A verified fit
 // is then refused when ambiguous (a fit at another place within reloc.ambiguity_margin of its inlier ratio),
 // and becomes the fix only once reloc.min_consistent_fixes queries agree (the loop closer's pairwise cycle
-// test with the session's odometry between them). Roadways repeat: refusing is better than guessing.
+// test with the session's odometry between them) and outnumber the waiting queries that contradict them
+// (loop/loop_consensus.hpp). Roadways repeat: refusing is better than guessing.
 // Localised: the pose in the map is T_map_session * session pose, every sweep; every reloc.track_distance the
 // sweep is verified against the nearest bundle keyframes (seeded by that pose) and the offset refined. Lost
 // (back to relocalising) after reloc.max_track_failures failed verifications in a row, a registration failure

@@ -2,6 +2,8 @@
 // x of its relative pose, and two loops agree when they put the query in the same place.
 #include "loop/loop_consensus.hpp"
 
+#include "core/types.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -18,15 +20,15 @@ LoopConstraint loopAt(int query, double place_x) {
   return l;
 }
 
-const LoopsAgree kSamePlace = [](const LoopConstraint& a, const LoopConstraint& b) {
+bool samePlace(const LoopConstraint& a, const LoopConstraint& b) {
   return std::abs(a.T_match_query.translation().x() - b.T_match_query.translation().x()) < 0.5;
-};
+}
 
 // Feeds loops one by one as the loop closer does; returns the accepted group (empty if none was accepted).
 std::vector<LoopConstraint> feed(const std::vector<LoopConstraint>& loops, int min_consistent, int* contested = nullptr) {
   std::vector<LoopConstraint> pending;
   for (const LoopConstraint& l : loops) {
-    LoopConsensus c = seekConsensus(pending, l, min_consistent, kSamePlace);
+    Consensus<LoopConstraint> c = seekConsensus(pending, l, min_consistent, samePlace);
     if (contested && c.contested) ++*contested;
     pending = c.pending;
     if (!c.accepted.empty()) return c.accepted;
@@ -61,10 +63,10 @@ TEST(LoopConsensus, AnAliasedPairDoesNotOutvoteTheTruePlace) {
 
 TEST(LoopConsensus, ContradictingLoopsStayWaitingWhenAGroupIsAccepted) {
   std::vector<LoopConstraint> pending{loopAt(10, 6.0)};
-  LoopConsensus c = seekConsensus(pending, loopAt(11, 0.0), 2, kSamePlace);
+  Consensus<LoopConstraint> c = seekConsensus(pending, loopAt(11, 0.0), 2, samePlace);
   EXPECT_TRUE(c.accepted.empty());
   EXPECT_FALSE(c.contested);  // one agreeing loop is not enough: waiting, not contested
-  c = seekConsensus(c.pending, loopAt(12, 0.0), 2, kSamePlace);
+  c = seekConsensus(c.pending, loopAt(12, 0.0), 2, samePlace);
   ASSERT_EQ(c.accepted.size(), 2u);  // 2 against 1
   ASSERT_EQ(c.pending.size(), 1u);
   EXPECT_EQ(c.pending[0].query_index, 10);
