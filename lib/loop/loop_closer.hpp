@@ -145,7 +145,8 @@ struct LoopCloserStats {
   int partial_loops = 0;       // accepted loops that leave one translation free (partial_loops)
   int optimizations = 0;
   int revisit_keyframes = 0;   // keyframes that kept only their graph node (revisit_distance)
-  // LinK3D (loop.keypoints) and consensus; like revisit_keyframes and partial_loops not in checkpoints (restart from 0).
+  // LinK3D (loop.keypoints) and consensus; like revisit_keyframes and partial_loops not in checkpoints
+  // (restart from 0).
   int keypoint_seeds = 0;       // candidates whose keypoints gave a seed
   int keypoint_loops = 0;       // verified fits that only the keypoints' seed found
   int rejected_ambiguous = 0;   // two accepted fits in different places, both within the odometry gate

@@ -25,7 +25,8 @@ bool samePlace(const LoopConstraint& a, const LoopConstraint& b) {
 }
 
 // Feeds loops one by one as the loop closer does; returns the accepted group (empty if none was accepted).
-std::vector<LoopConstraint> feed(const std::vector<LoopConstraint>& loops, int min_consistent, int* contested = nullptr) {
+std::vector<LoopConstraint> feed(const std::vector<LoopConstraint>& loops, int min_consistent,
+                                 int* contested = nullptr) {
   std::vector<LoopConstraint> pending;
   for (const LoopConstraint& l : loops) {
     Consensus<LoopConstraint> c = seekConsensus(pending, l, min_consistent, samePlace);
