@@ -359,8 +359,8 @@ PoseEstimate ScanToScanOdometry::process(const FeatureSet& f, const std::optiona
   } else {
     out.flags |= PoseEstimate::kSeededByMotionModel;
   }
-  // Along degenerate directions hold to the motion model (IMU-aided if the prior came from the IMU), never
-  // to a LinK3D seed: that one is measured from the same, degenerate, geometry.
+  // Along degenerate directions hold to the motion model (with the IMU's rotation if the prior came from the
+  // IMU), never to a LinK3D seed: that one is measured from the same, degenerate, geometry.
   const bool imu_prior = prior_usable && (prior_flags & PoseEstimate::kSeededByImu) != 0;
   // A measured motion (wheel odometry) observes what the lidar cannot: hold to it first.
   const bool held_to_measured = measured && isFinitePose(measured->T_prev_curr);

@@ -81,7 +81,9 @@ struct ScanToScanConfig {
   // estimated motions rather than the last one. Where the roadway axis is barely observed (just before it is
   // flagged degenerate) a single sweep's axial motion errs by ~3 cm (20% at 1.3 m/s), and the prior then
   // carries whatever the last sweep said along the whole degenerate stretch. A robot's speed changes slowly
-  // (0.3 m/s^2 is 3 cm/s a sweep), so averaging over ~1 s costs little lag. 0 = the last motion.
+  // (0.3 m/s^2 is 3 cm/s a sweep), so averaging over ~1 s costs little lag. 0 = the last motion. With an
+  // IMU too: its seed's translation is the last step (held, it made the 320 m featureless world 10.5 % long
+  // instead of 3.0 %); only its rotation is taken.
   double hold_velocity_time_constant_s = 1.0;
   // That average weighs each sweep's velocity along each translation eigen-direction of the registration's
   // information (every residual, edges too) by how well it was observed: not at all below
