@@ -96,14 +96,18 @@ World featurelessCorridor() {
   return w;
 }
 
+void addWallPillars(World& world, double from_x, double to_x, double spacing) {
+  int k = 0;
+  for (double x = from_x; x < to_x; x += spacing, ++k) {
+    const double y0 = (k % 2 == 0) ? -2.5 : 2.1;  // 0.4 m deep pillars on alternating walls
+    world.boxes.push_back({{x, y0, -1.2}, {x + 0.5, y0 + 0.4, 2.5}, false});
+  }
+}
+
 World roadwayWithPillars(double length, double spacing) {
   World w;
   w.boxes.push_back({{-50, -2.5, -1.2}, {length + 50, 2.5, 2.5}, true});
-  int k = 0;
-  for (double x = -40; x < length + 40; x += spacing, ++k) {
-    const double y0 = (k % 2 == 0) ? -2.5 : 2.1;  // 0.4 m deep pillars on alternating walls
-    w.boxes.push_back({{x, y0, -1.2}, {x + 0.5, y0 + 0.4, 2.5}, false});
-  }
+  addWallPillars(w, -40, length + 40, spacing);
   return w;
 }
 

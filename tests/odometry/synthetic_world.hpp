@@ -34,6 +34,9 @@ World boxRoom();
 World featurelessCorridor();
 // A straight roadway along x with a support pillar on alternating walls every `spacing` metres.
 World roadwayWithPillars(double length, double spacing);
+// Adds such pillars (0.4 m deep, on the walls of a 5 m wide roadway, the first at y < 0) from `from_x` up to
+// `to_x`.
+void addWallPillars(World& world, double from_x, double to_x, double spacing);
 
 // One sweep from T_world_lidar, deskewed (dt = 0), features labelled; `seed` drives the range noise.
 FeatureSet simulateSweep(const World& world, const Eigen::Isometry3d& T_world_lidar, const LidarModel& lidar,

@@ -135,11 +135,7 @@ TEST(Degeneracy, AxisDriftIsBoundedComparedWithNoPrior) {
 TEST(Degeneracy, WithAnImuPriorTheAxisHoldsTheAveragedSpeedNotTheLastStep) {
   test::World world;
   world.boxes.push_back({{-50, -2.5, -1.2}, {400, 2.5, 2.5}, true});
-  int k = 0;
-  for (double x = -40; x < 10; x += 3.0, ++k) {
-    const double y0 = (k % 2 == 0) ? -2.5 : 2.1;
-    world.boxes.push_back({{x, y0, -1.2}, {x + 0.5, y0 + 0.4, 2.5}, false});
-  }
+  test::addWallPillars(world, -40, 10, 3.0);
   test::LidarModel lidar;
   lidar.max_range = 15.0;
   ScanToScanOdometry odom;
