@@ -75,6 +75,22 @@ void KeyframeCloudStore::drop(int k) {
   slot = Slot{CompactCloud::encode({}, slot.step > 0 ? slot.step : 1e-3f), -1, 0, slot.step};
 }
 
+void KeyframeCloudStore::retain(const std::vector<bool>& keep) {
+  std::size_t out = 0, next_to_page = 0;
+  for (std::size_t k = 0; k < slots_.size(); ++k) {
+    if (k < keep.size() && !keep[k]) {
+      resident_bytes_ -= slots_[k].cloud.bytes();
+      continue;
+    }
+    if (k < next_to_page_) ++next_to_page;
+    if (out != k) slots_[out] = std::move(slots_[k]);  // never onto itself: a self-moved vector is emptied
+    ++out;
+  }
+  slots_.resize(out);
+  slots_.shrink_to_fit();
+  next_to_page_ = next_to_page;
+}
+
 bool KeyframeCloudStore::empty(int k) const { return slots_.at(static_cast<std::size_t>(k)).points == 0; }
 
 CompactCloud KeyframeCloudStore::cloud(int k) const {

@@ -23,6 +23,9 @@ class KeyframeCloudStore {
 
   void add(CompactCloud cloud);
   void drop(int k);  // keeps nothing of keyframe k's cloud (a revisit)
+  // Only the slots with keep[k] stay, renumbered in order (keyframes merged out of the graph). A paged cloud
+  // stays where it is in the page file.
+  void retain(const std::vector<bool>& keep);
   std::size_t size() const { return slots_.size(); }
   bool empty(int k) const;
   // Keyframe k's cloud, from memory or the page file; an unreadable page gives an empty cloud (readErrors()).

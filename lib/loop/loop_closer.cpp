@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace adit {
 namespace {
@@ -101,6 +102,7 @@ LoopCloser::Result LoopCloser::process(const PoseEstimate& mapped, const LidarSc
       }
     }
     applyDue(mapped.utime, false, result);
+    if (result.keyframe_added) retireRevisits(result);
   }
   if (!keyframes_.empty()) result.T_corrected_uncorrected = correction(static_cast<int>(keyframes_.size()) - 1);
   return result;
@@ -246,6 +248,7 @@ ScanContext LoopCloser::addKeyframe(const PoseEstimate& mapped, const LidarScan&
   Keyframe kf;
   kf.utime = mapped.utime;
   kf.uncorrected = mapped.pose;
+  kf.seq = stats_.keyframes;
 
   if (keyframes_.empty()) {
     chain_.add(mapped.pose, Matrix6d::Zero());
@@ -278,24 +281,47 @@ Eigen::Isometry3d LoopCloser::correction(int keyframe) const {
   return graph_.pose(keyframe) * keyframes_[static_cast<std::size_t>(keyframe)].uncorrected.inverse();
 }
 
+int LoopCloser::indexOfKeyframe(std::int64_t seq) const {
+  const auto it = std::lower_bound(keyframes_.begin(), keyframes_.end(), seq,
+                                   [](const Keyframe& k, std::int64_t s) { return k.seq < s; });
+  return it != keyframes_.end() && it->seq == seq ? static_cast<int>(it - keyframes_.begin()) : -1;
+}
+
 Trajectory LoopCloser::correctedTrajectory(const Trajectory& uncorrected) const {
   if (keyframes_.empty()) return uncorrected;
+  // Every keyframe's correction in time order: the graph's, and those merged out as they were then.
   std::vector<std::int64_t> utimes;
-  for (const Keyframe& k : keyframes_) utimes.push_back(k.utime);
-  const int n = static_cast<int>(keyframes_.size());
+  std::vector<Eigen::Isometry3d> corrections;
+  std::size_t r = 0;
+  for (std::size_t k = 0; k <= keyframes_.size(); ++k) {
+    const std::int64_t next = k < keyframes_.size() ? keyframes_[k].utime : std::numeric_limits<std::int64_t>::max();
+    for (; r < retired_.size() && retired_[r].utime < next; ++r) {
+      const RetiredKeyframe& x = retired_[r];
+      Eigen::Isometry3d c = Eigen::Isometry3d::Identity();
+      c.linear() = Eigen::Quaterniond(x.rotation[3], x.rotation[0], x.rotation[1], x.rotation[2]).normalized().toRotationMatrix();
+      c.translation() = Eigen::Vector3d(x.translation[0], x.translation[1], x.translation[2]);
+      utimes.push_back(x.utime);
+      corrections.push_back(c);
+    }
+    if (k == keyframes_.size()) break;
+    utimes.push_back(keyframes_[k].utime);
+    corrections.push_back(correction(static_cast<int>(k)));
+  }
+  const int n = static_cast<int>(utimes.size());
   Trajectory out;
   out.reserve(uncorrected.size());
   for (const StampedPose& sp : uncorrected) {
     const int b = static_cast<int>(std::upper_bound(utimes.begin(), utimes.end(), sp.utime) - utimes.begin());
     Eigen::Isometry3d C;
     if (b == 0) {
-      C = correction(0);
+      C = corrections.front();
     } else if (b == n) {
-      C = correction(n - 1);
+      C = corrections.back();
     } else {
-      const double span = static_cast<double>(utimes[static_cast<std::size_t>(b)] - utimes[static_cast<std::size_t>(b - 1)]);
-      const double s = span > 0 ? static_cast<double>(sp.utime - utimes[static_cast<std::size_t>(b - 1)]) / span : 0.0;
-      C = interpolate(correction(b - 1), correction(b), s);
+      const auto i = static_cast<std::size_t>(b);
+      const double span = static_cast<double>(utimes[i] - utimes[i - 1]);
+      const double s = span > 0 ? static_cast<double>(sp.utime - utimes[i - 1]) / span : 0.0;
+      C = interpolate(corrections[i - 1], corrections[i], s);
     }
     out.push_back({sp.utime, C * sp.pose});
   }

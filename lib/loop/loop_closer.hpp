@@ -25,6 +25,7 @@
 #include "loop/pose_graph.hpp"
 #include "loop/scan_context_database.hpp"
 
+#include <limits>
 #include <memory>
 #include <optional>
 #include <string>
@@ -63,6 +64,13 @@ struct LoopCloserConfig {
   // (< 1 kB) per keyframe instead of ~40 kB. 0 keeps every keyframe's cloud.
   double revisit_distance = 1.0;
   int revisit_trust_keyframes = 30;
+  // A keyframe without a cloud (a revisit) older than the newest retire_after_keyframes is merged out of the
+  // pose graph (loop/graph_merge.hpp), retire_batch at a time: the graph, the odometry chain and the Scan
+  // Context database then follow the roadway mapped too, and the keyframe leaves only its final correction
+  // (40 bytes, for the corrected trajectory). Must exceed exclude_recent_keyframes, consistency_window and
+  // revisit_trust_keyframes (their windows count keyframes); 0 keeps every keyframe.
+  int retire_after_keyframes = 200;
+  int retire_batch = 50;
 
   // --- scheduling (loop/loop_job.hpp) ---
   // Verification and graph optimisation run as a job; its outcome is applied at the first sweep this much
@@ -151,6 +159,7 @@ struct LoopCloserStats {
   int keypoint_loops = 0;       // verified fits that only the keypoints' seed found
   int rejected_ambiguous = 0;   // two accepted fits in different places, both within the odometry gate
   int contested = 0;            // enough loops agreed but waited: as many waiting loops contradicted them
+  int retired_keyframes = 0;    // merged out of the graph (retire_after_keyframes)
 };
 
 class LoopScheduler;
@@ -186,11 +195,21 @@ class LoopCloser {
   // Keyframe clouds at their corrected poses, voxel-downsampled (voxel <= 0: no downsampling).
   std::vector<Eigen::Vector3f> correctedMap(double voxel) const;
 
+  // keyframes()[k] is keyframe index k: the order of the graph's nodes, which shifts when older keyframes are
+  // merged out (loop.retire_after_keyframes). seq is a keyframe's number in the order keyframes were made
+  // (0, 1, 2, ...), which never changes: what checkpoints and messages name a keyframe by.
   struct Keyframe {
     std::int64_t utime = 0;
     Eigen::Isometry3d uncorrected = Eigen::Isometry3d::Identity();  // mapped T_world_lidar
+    std::int64_t seq = 0;
   };
   const std::vector<Keyframe>& keyframes() const { return keyframes_; }
+  // Index of the keyframe numbered seq, or -1 if it was merged out (or never made).
+  int indexOfKeyframe(std::int64_t seq) const;
+  // Keyframes numbered seq and later are never merged out (a live process's keyframes not yet in its
+  // checkpoint log, whose records must still be written). Default: no limit.
+  void keepKeyframesFrom(std::int64_t seq) { keep_from_seq_ = seq; }
+  std::size_t retiredKeyframes() const { return retired_.size(); }
   // Keyframe k's cloud (downsampled, lidar frame; empty for a revisit), from memory or the page file.
   CompactCloud keyframeCloud(int k) const { return clouds_.cloud(k); }
   // Keyframe k's LinK3D keypoints (empty for a revisit or a sweep without them).
@@ -220,6 +239,7 @@ class LoopCloser {
   bool isKeyframe(const Eigen::Isometry3d& pose) const;
   ScanContext addKeyframe(const PoseEstimate& mapped, const LidarScan& cloud, KeyframeKeypointsPtr keypoints);
   bool isRevisit(int keyframe) const;
+  void retireRevisits(Result& result);  // loop_closer_retire.cpp
   Matrix6d stepCovariance(const Eigen::Isometry3d& new_pose) const;
   void submitJob(int query, const ScanContext& context);
   void applyDue(std::int64_t utime, bool all, Result& result);
@@ -239,6 +259,14 @@ class LoopCloser {
   int last_loop_query_ = -1000000;
   LoopCloserStats stats_;
   std::unique_ptr<LoopScheduler> scheduler_;  // created with the first job
+  // Keyframes merged out of the graph: their correction as it was then, in time order, for correctedTrajectory.
+  struct RetiredKeyframe {
+    std::int64_t utime = 0;
+    float translation[3] = {0, 0, 0};
+    float rotation[4] = {0, 0, 0, 1};  // quaternion x y z w
+  };
+  std::vector<RetiredKeyframe> retired_;
+  std::int64_t keep_from_seq_ = std::numeric_limits<std::int64_t>::max();
 };
 
 }  // namespace adit

@@ -54,8 +54,13 @@ std::vector<LoopConstraint> getLoops(ByteReader& r, int keyframes) {
 std::vector<int*> statFields(LoopCloserStats& s) {
   return {&s.sweeps, &s.invalid_sweeps, &s.keyframes, &s.queries, &s.candidates, &s.rejected_fitness,
           &s.rejected_degenerate, &s.rejected_odometry, &s.rejected_pairwise, &s.pending, &s.accepted,
-          &s.optimizations};
+          &s.optimizations, &s.retired_keyframes};
 }
+
+// Leads the state: a checkpoint of the format before keyframes could be merged out (which began with the
+// keyframe count) is refused rather than misread.
+constexpr std::uint64_t kStateFormat = 0xAD17'0002'0000'0000ULL;
+constexpr std::size_t kRetiredBytes = 8 + 7 * 4;
 
 }  // namespace
 
@@ -73,8 +78,16 @@ std::string LoopCloser::keyframeRecord(int k) const {
 
 std::string LoopCloser::saveState() const {
   ByteWriter w;
+  w.put<std::uint64_t>(kStateFormat);
+  // Records the keyframe log holds: one per keyframe ever made (seq order), merged out or not.
+  w.put<std::uint64_t>(static_cast<std::uint64_t>(stats_.keyframes));
+  // The keyframes in the graph: number, graph pose and chain step (a merged step is not the record's).
   w.put<std::uint64_t>(keyframes_.size());
-  for (int k = 0; k < graph_.size(); ++k) w.putPose(graph_.pose(k));
+  for (int k = 0; k < graph_.size(); ++k) {
+    w.put<std::int64_t>(keyframes_[static_cast<std::size_t>(k)].seq);
+    w.putPose(graph_.pose(k));
+    w.putMatrix(chain_.stepCovariance(k));
+  }
   w.put<std::uint64_t>(graph_.edges().size());
   for (const PoseGraphEdge& e : graph_.edges()) {
     w.put<std::int32_t>(e.from);
@@ -93,35 +106,51 @@ std::string LoopCloser::saveState() const {
   w.put<std::int32_t>(last_loop_query_);
   LoopCloserStats stats = stats_;
   for (int* field : statFields(stats)) w.put<std::int32_t>(*field);
+  w.put<std::uint64_t>(retired_.size());
+  for (const RetiredKeyframe& x : retired_) {
+    w.put<std::int64_t>(x.utime);
+    for (float v : x.translation) w.put<float>(v);
+    for (float v : x.rotation) w.put<float>(v);
+  }
   return w.bytes();
 }
 
 std::size_t LoopCloser::keyframesInState(const std::string& state) {
   ByteReader r(state);
-  const auto n = r.getCount(96);
-  return r.ok() ? n : 0;
+  const auto format = r.get<std::uint64_t>();
+  const auto records = r.get<std::uint64_t>();
+  return r.ok() && format == kStateFormat && records < (1ULL << 31) ? static_cast<std::size_t>(records) : 0;
 }
 
 bool LoopCloser::restoreState(const std::string& state, const std::vector<std::string>& keyframe_records) {
   ByteReader r(state);
   LoopCloser restored(config_);
-  const auto n = r.getCount(96);  // a graph pose per keyframe
-  if (!r.ok() || keyframe_records.size() < n) return false;
+  const std::size_t records = keyframesInState(state);
+  r.get<std::uint64_t>();
+  r.get<std::uint64_t>();
+  const auto n = r.getCount(8 + 96 + 288);  // seq, graph pose and step per keyframe
+  if (!r.ok() || keyframe_records.size() < records || n > records) return false;
+  std::int64_t previous_seq = -1;
   for (std::uint64_t k = 0; k < n && r.ok(); ++k) {
-    const std::string& record = keyframe_records[k];
-    ByteReader kr(record);
+    const std::int64_t seq = r.get<std::int64_t>();
+    const Eigen::Isometry3d pose = r.getPose();
+    const Matrix6d step = r.getMatrix<Matrix6d>();
+    if (!r.ok() || seq <= previous_seq || seq >= static_cast<std::int64_t>(records)) return false;
+    previous_seq = seq;
+    ByteReader kr(keyframe_records[static_cast<std::size_t>(seq)]);
     Keyframe kf;
+    kf.seq = seq;
     kf.utime = kr.get<std::int64_t>();
     kf.uncorrected = kr.getPose();
     std::optional<CompactCloud> cloud = getCompactCloud(kr);
     std::optional<ScanContext> context = cloud ? getScanContext(kr) : std::nullopt;
     if (!context) return false;
-    const Matrix6d step = kr.getMatrix<Matrix6d>();
+    kr.getMatrix<Matrix6d>();  // the step as first made; the state's is the graph's now
     std::optional<KeyframeKeypoints> keypoints = KeyframeKeypoints();
     if (kr.ok() && !kr.atEnd()) keypoints = KeyframeKeypoints::get(kr);
     if (!kr.ok() || !kr.atEnd() || !keypoints) return false;
     restored.chain_.add(kf.uncorrected, step);
-    restored.graph_.addNode(r.getPose());
+    restored.graph_.addNode(pose);
     restored.database_.add(*context, kf.utime);
     restored.keyframes_.push_back(std::move(kf));
     restored.clouds_.add(std::move(*cloud));
@@ -148,9 +177,17 @@ bool LoopCloser::restoreState(const std::string& state, const std::vector<std::s
   }
   restored.last_loop_query_ = r.get<std::int32_t>();
   for (int* field : statFields(restored.stats_)) *field = r.get<std::int32_t>();
-  if (!r.ok() || !r.atEnd()) return false;
-  // Not a saved field (older checkpoints lack it): a revisit keyframe is the one record without a cloud.
-  restored.stats_.revisit_keyframes = 0;
+  const auto retired = r.getCount(kRetiredBytes);
+  for (std::uint64_t i = 0; i < retired && r.ok(); ++i) {
+    RetiredKeyframe x;
+    x.utime = r.get<std::int64_t>();
+    for (float& v : x.translation) v = r.get<float>();
+    for (float& v : x.rotation) v = r.get<float>();
+    restored.retired_.push_back(x);
+  }
+  if (!r.ok() || !r.atEnd() || restored.stats_.keyframes != static_cast<int>(records)) return false;
+  // Not a saved field: a revisit keyframe is one without a cloud (those merged out counted as revisits).
+  restored.stats_.revisit_keyframes = static_cast<int>(restored.retired_.size());
   for (int k = 0; k < static_cast<int>(restored.clouds_.size()); ++k)
     restored.stats_.revisit_keyframes += restored.clouds_.empty(k) ? 1 : 0;
   restored.stats_.partial_loops =

@@ -67,6 +67,8 @@ class LoopScheduler {
   // Outcomes due at `utime` (all of them when `all`), oldest first; waits for those not finished.
   std::vector<LoopJobOutcome> take(std::int64_t utime, bool all = false);
   std::size_t inFlight() const { return pending_.size(); }
+  // With no job in flight (after take(all)): the book renumbered by the loop closer (keyframes merged out).
+  void replaceBook(LoopBook book) { book_ = std::move(book); }
   double waitedMs() const { return waited_ms_; }
 
  private:

@@ -41,6 +41,23 @@ int ScanContextDatabase::add(const ScanContext& context, std::int64_t utime) {
   return size() - 1;
 }
 
+void ScanContextDatabase::retain(const std::vector<bool>& keep) {
+  std::size_t out = 0;
+  for (std::size_t i = 0; i < contexts_.size(); ++i) {
+    if (i < keep.size() && !keep[i]) continue;
+    if (out != i) contexts_[out] = std::move(contexts_[i]);  // never onto itself
+    utimes_[out] = utimes_[i];
+    ++out;
+  }
+  contexts_.resize(out);
+  utimes_.resize(out);
+  contexts_.shrink_to_fit();
+  utimes_.shrink_to_fit();
+  tree_.reset();
+  tree_size_ = 0;
+  if (size() >= rebuild_every_) rebuildTree();
+}
+
 void ScanContextDatabase::rebuildTree() {
   std::size_t dim = 0;  // of the first real context (a revisit keyframe's is empty)
   for (const ScanContext& c : contexts_)

@@ -39,6 +39,9 @@ class ScanContextDatabase {
       const ScanContext& context, int exclude_recent,
       std::int64_t latest_utime = std::numeric_limits<std::int64_t>::max()) const;
 
+  // Only the entries with keep[i] stay, renumbered in order (keyframes merged out of the graph).
+  void retain(const std::vector<bool>& keep);
+
   int size() const { return static_cast<int>(contexts_.size()); }
   const ScanContext& context(int index) const { return contexts_[static_cast<std::size_t>(index)]; }
 

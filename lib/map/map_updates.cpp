@@ -3,6 +3,8 @@
 #include "core/geometry.hpp"
 #include "loop/voxel_filter.hpp"
 
+#include <algorithm>
+
 namespace adit {
 
 const ConfigTable<MapUpdateConfig>& mapUpdateConfigTable() {
@@ -31,23 +33,33 @@ std::optional<MapUpdate> MapUpdateTracker::update(std::int64_t utime, const Loop
   out.num_submaps = static_cast<int>(keyframes.size());
   out.num_loops = static_cast<int>(closer.acceptedLoops().size());
   const double max_angle = config_.move_threshold_deg * 3.14159265358979323846 / 180.0;
-  for (std::size_t k = 0; k < sent_.size() && static_cast<int>(out.moved.size()) < config_.max_moved; ++k) {
+  // Sent submaps and the keyframes are both in seq order: walk them together.
+  std::size_t k = 0, kept = 0;
+  for (Sent& sent : sent_) {
+    while (k < keyframes.size() && keyframes[k].seq < sent.seq) ++k;
+    if (k == keyframes.size() || keyframes[k].seq != sent.seq) continue;  // merged out: never moves again
     const Eigen::Isometry3d& now = graph.pose(static_cast<int>(k));
-    const Eigen::Isometry3d delta = sent_[k].inverse() * now;
-    if (translationNorm(delta) < config_.move_threshold_m && rotationAngle(delta) < max_angle) continue;
-    out.moved.push_back({static_cast<int>(k), keyframes[k].utime, now});
-    sent_[k] = now;
+    const Eigen::Isometry3d delta = sent.pose.inverse() * now;
+    const bool moved = translationNorm(delta) >= config_.move_threshold_m || rotationAngle(delta) >= max_angle;
+    if (moved && static_cast<int>(out.moved.size()) < config_.max_moved) {
+      out.moved.push_back({static_cast<int>(sent.seq), keyframes[k].utime, now});
+      sent.pose = now;
+    }
+    sent_[kept++] = sent;
   }
+  sent_.resize(kept);
   std::size_t points = 0;
-  while (sent_.size() < keyframes.size()) {
-    const std::size_t k = sent_.size();
+  const auto unsent = std::lower_bound(keyframes.begin(), keyframes.end(), next_seq_,
+                                       [](const LoopCloser::Keyframe& kf, std::int64_t seq) { return kf.seq < seq; });
+  for (k = static_cast<std::size_t>(unsent - keyframes.begin()); k < keyframes.size(); ++k) {
     std::vector<Eigen::Vector3f> decimated = voxelDownsample(closer.keyframeCloud(static_cast<int>(k)).decode(), config_.voxel_m);
     // Always at least one submap per update, so a huge one cannot stall the stream.
     if (!out.added.empty() && points + decimated.size() > static_cast<std::size_t>(config_.max_points)) break;
     points += decimated.size();
     const Eigen::Isometry3d pose = graph.pose(static_cast<int>(k));
-    out.added.push_back({{static_cast<int>(k), keyframes[k].utime, pose}, std::move(decimated)});
-    sent_.push_back(pose);
+    out.added.push_back({{static_cast<int>(keyframes[k].seq), keyframes[k].utime, pose}, std::move(decimated)});
+    sent_.push_back({keyframes[k].seq, pose});
+    next_seq_ = keyframes[k].seq + 1;
   }
   if (out.added.empty() && out.moved.empty()) return std::nullopt;
   last_utime_ = utime;

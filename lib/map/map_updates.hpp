@@ -26,7 +26,7 @@ const ConfigTable<MapUpdateConfig>& mapUpdateConfigTable();
 MapUpdateConfig mapUpdateConfigFrom(const Config& config);
 
 struct SubmapPose {
-  int id = 0;
+  int id = 0;  // the keyframe's number in the order made (LoopCloser::Keyframe::seq)
   std::int64_t utime = 0;
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
 };
@@ -53,7 +53,12 @@ class MapUpdateTracker {
 
  private:
   MapUpdateConfig config_;
-  std::vector<Eigen::Isometry3d> sent_;  // pose each submap was last sent with
+  struct Sent {
+    std::int64_t seq = 0;
+    Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();  // as last sent
+  };
+  std::vector<Sent> sent_;  // by seq; a keyframe merged out of the graph is forgotten
+  std::int64_t next_seq_ = 0;  // the first keyframe not sent yet
   std::int64_t last_utime_ = -1;
 };
 

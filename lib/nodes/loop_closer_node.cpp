@@ -151,6 +151,8 @@ class LoopCloserNode : public runtime::Node, public WritesProducts, public Write
     mapped.pose = makePose(m.loop_correction_position, m.loop_correction_orientation).inverse() * mapped.pose;
     const LidarScan cloud = msg::featuresOf(m).cloud;
     trajectory_.push_back({mapped.utime, mapped.pose});
+    // A keyframe is merged out of the graph only once its record is in the checkpoint log.
+    if (state_.live()) closer_.keepKeyframesFrom(static_cast<std::int64_t>(keyframes_written_->load()));
     const LoopCloser::Result result = closer_.process(mapped, cloud, takeKeypoints(mapped.utime));
     publishResult(mapped.utime, result);
     if (const auto update = updates_.update(mapped.utime, closer_)) publishMapUpdate(*update);
@@ -187,6 +189,9 @@ class LoopCloserNode : public runtime::Node, public WritesProducts, public Write
   void publishResult(std::int64_t utime, const LoopCloser::Result& result) {
     for (const LoopConstraint& loop : result.loops) {
       adit::loop_closure_t out = msg::toMessage(loop, utime);
+      // Keyframes by their number in the order made, which merging older keyframes out does not shift.
+      out.query_index = static_cast<std::int32_t>(closer_.keyframes()[static_cast<std::size_t>(loop.query_index)].seq);
+      out.match_index = static_cast<std::int32_t>(closer_.keyframes()[static_cast<std::size_t>(loop.match_index)].seq);
       publish("loop", out);
     }
     if (result.graph_updated) publishGraph(utime, result);
@@ -243,10 +248,17 @@ class LoopCloserNode : public runtime::Node, public WritesProducts, public Write
   // written on the writer thread (a slow disk must not stall loop detection); a job superseded before it
   // ran is covered by the next, which carries every keyframe the log does not hold yet.
   void checkpoint() {
+    // Records are in keyframe number order (seq); keepKeyframesFrom keeps every unwritten one in the graph.
     const std::size_t first = keyframes_written_->load();
     std::vector<std::string> records;
-    for (std::size_t k = first; k < closer_.keyframes().size(); ++k)
-      records.push_back(closer_.keyframeRecord(static_cast<int>(k)));
+    for (std::size_t seq = first; seq < static_cast<std::size_t>(closer_.stats().keyframes); ++seq) {
+      const int k = closer_.indexOfKeyframe(static_cast<std::int64_t>(seq));
+      if (k < 0) {
+        reportError("checkpoint_failed", "keyframe " + std::to_string(seq) + " was merged out before it was written");
+        return;
+      }
+      records.push_back(closer_.keyframeRecord(k));
+    }
     TrajectoryLog::Chunk poses = trajectory_.unwritten();
     ByteWriter w;
     w.putString(closer_.saveState());

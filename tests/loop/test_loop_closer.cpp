@@ -104,13 +104,14 @@ void drive(Drive& run, const BoxWorld& world, const std::vector<Eigen::Isometry3
       r.loops.insert(r.loops.end(), last.loops.begin(), last.loops.end());
     }
     for (const LoopConstraint& loop : r.loops) {
-      run.applied.emplace_back(static_cast<int>(k), loop.query_index);
-      const Eigen::Isometry3d T_true = truth[static_cast<std::size_t>(loop.match_index)].inverse() *
-                                       truth[static_cast<std::size_t>(loop.query_index)];
+      // Keyframe k is sweep k: its number (seq) indexes the truth whatever was merged out of the graph.
+      const auto seq = [&](int index) { return static_cast<std::size_t>(run.closer.keyframes()[static_cast<std::size_t>(index)].seq); };
+      run.applied.emplace_back(static_cast<int>(k), static_cast<int>(seq(loop.query_index)));
+      const Eigen::Isometry3d T_true = truth[seq(loop.match_index)].inverse() * truth[seq(loop.query_index)];
       // Where the loop measures: a partial loop leaves the roadway's axis to the odometry.
       const double err = measuredPart(loop, (T_true.inverse() * loop.T_match_query).translation()).norm();
-      std::printf("loop %d -> %d: sc %.3f, rms %.3f m, inliers %.2f, error vs truth %.3f m\n", loop.query_index,
-                  loop.match_index, loop.scan_context_distance, loop.fitness, loop.inlier_ratio, err);
+      std::printf("loop %zu -> %zu: sc %.3f, rms %.3f m, inliers %.2f, error vs truth %.3f m\n", seq(loop.query_index),
+                  seq(loop.match_index), loop.scan_context_distance, loop.fitness, loop.inlier_ratio, err);
       if (err > 0.5) ++run.false_loops;
     }
   }
@@ -241,6 +242,85 @@ TEST(LoopCloser, RevisitedKeyframesKeepOnlyTheirGraphNode) {
   EXPECT_LT(store.residentBytes(), thin.closer.clouds().residentBytes() / 5);
   EXPECT_EQ(store.readErrors(), 0u);
   EXPECT_EQ(store.pageErrors(), 0u);
+}
+
+// A patrol: the block driven three times. Once the second lap revisits the first, its keyframes keep only a
+// graph node, and those older than loop.retire_after_keyframes are merged out of the graph: the graph follows
+// the roadway, not the time driven. Loops keep closing on the third lap, the corrected trajectory is as good as
+// with every node kept (the merged keyframes keep their corrections), and a checkpoint taken after merging
+// restores to the same state and goes on exactly as the closer that wrote it.
+TEST(LoopCloser, APatrolMergesItsRevisitsOutOfTheGraph) {
+  const BoxWorld world = blockLoop();
+  const auto truth = lapPoses(3 * 140 + 10);
+  const auto mapped = drifted(truth, 0.02 * kDeg);
+  LoopCloserConfig merging = testConfig(), keep_all = testConfig();
+  merging.retire_after_keyframes = 60;
+  merging.retire_batch = 20;
+  keep_all.retire_after_keyframes = 0;
+  Drive merged{LoopCloser{merging}, 0, {}}, all{LoopCloser{keep_all}, 0, {}};
+  drive(merged, world, truth, mapped);
+  drive(all, world, truth, mapped);
+  printStats(merged.closer.stats());
+  const LoopCloserStats& s = merged.closer.stats();
+  const int in_graph = merged.closer.graph().size();
+  std::printf("keyframes %d: %d in the graph, %d merged out (%d revisits); every node kept: %d\n", s.keyframes,
+              in_graph, s.retired_keyframes, s.revisit_keyframes, all.closer.graph().size());
+  EXPECT_EQ(all.closer.stats().retired_keyframes, 0);
+  EXPECT_EQ(in_graph, static_cast<int>(merged.closer.keyframes().size()));
+  EXPECT_EQ(in_graph + s.retired_keyframes, s.keyframes);
+  EXPECT_GE(s.retired_keyframes, 150) << "most of laps two and three";
+  EXPECT_LE(in_graph, 140 + 60 + 20 + 40) << "the first lap, the recent window, a batch, a few kept later";
+  EXPECT_EQ(merged.false_loops, 0);
+  EXPECT_TRUE(std::any_of(merged.applied.begin(), merged.applied.end(), [](const auto& a) { return a.second >= 300; }))
+      << "loops close on the third lap";
+
+  Trajectory uncorrected;
+  for (std::size_t k = 0; k < truth.size(); ++k) uncorrected.push_back({static_cast<std::int64_t>(k) * 1000000, mapped[k]});
+  auto corrected = [&](const LoopCloser& c) {
+    std::vector<Eigen::Isometry3d> out;
+    for (const StampedPose& p : c.correctedTrajectory(uncorrected)) out.push_back(p.pose);
+    return out;
+  };
+  const double ate_merged = ate(corrected(merged.closer), truth), ate_all = ate(corrected(all.closer), truth);
+  std::printf("ATE %.3f m uncorrected, %.3f m keeping every node, %.3f m merging revisits out\n", ate(mapped, truth),
+              ate_all, ate_merged);
+  EXPECT_LE(ate_merged, std::max(1.2 * ate_all, ate_all + 0.05));
+  EXPECT_LE(ate_merged, 0.5 * ate(mapped, truth));
+
+  // Checkpoint after merging: the keyframe log holds a record per keyframe made (merged out or not). Loop jobs
+  // applied in the sweep that posts them, so that none is in flight at the checkpoint (a restart loses those).
+  LoopCloserConfig same_sweep = merging;
+  same_sweep.apply_delay_s = 0;
+  LoopCloser live{same_sweep}, restored{same_sweep};
+  std::vector<std::string> records;
+  const std::size_t split = 330;
+  for (std::size_t k = 0; k < truth.size(); ++k) {
+    PoseEstimate pe;
+    pe.utime = static_cast<std::int64_t>(k) * 1000000;
+    pe.pose = mapped[k];
+    LidarScan scan = simulateSweep(world, truth[k], static_cast<std::uint32_t>(k + 1), 450);
+    scan.utime = pe.utime;
+    live.process(pe, scan);
+    if (live.stats().keyframes > static_cast<int>(records.size()))
+      records.push_back(live.keyframeRecord(static_cast<int>(live.keyframes().size()) - 1));
+    if (k == split) {
+      ASSERT_GT(live.stats().retired_keyframes, 0);
+      ASSERT_TRUE(restored.restoreState(live.saveState(), records));
+      EXPECT_TRUE(restored.saveState() == live.saveState());
+      EXPECT_EQ(restored.correctedTrajectory(uncorrected).back().pose.matrix(),
+                live.correctedTrajectory(uncorrected).back().pose.matrix());
+      // A log that lacks a record the state names is refused, and leaves the closer as it was.
+      LoopCloser refused{same_sweep};
+      EXPECT_FALSE(refused.restoreState(live.saveState(), {records.begin(), records.end() - 1}));
+      EXPECT_TRUE(refused.keyframes().empty());
+    } else if (k > split) {
+      restored.process(pe, scan);
+    }
+  }
+  live.finish();
+  restored.finish();
+  EXPECT_TRUE(restored.saveState() == live.saveState());
+  EXPECT_GT(live.stats().accepted, 0);
 }
 
 TEST(LoopCloser, RejectsAPeriodicRoadway) {

@@ -1,6 +1,8 @@
 // Pose graph: a drifting square loop closed by one loop edge, and the g2o round trip.
 #include "loop/pose_graph.hpp"
 
+#include "loop/graph_merge.hpp"
+
 #include "core/geometry.hpp"
 
 #include <gtest/gtest.h>
@@ -123,4 +125,68 @@ TEST(PoseGraph, G2oRoundTripKeepsPosesEdgesAndInformation) {
   std::stringstream broken("VERTEX_SE3:QUAT 0 0 0 0 0 0 0 1\nEDGE_SE3:QUAT 0 7 1 2\n");
   EXPECT_FALSE(readG2o(broken, from_file));
   EXPECT_EQ(from_file.size(), g.size());
+}
+
+namespace {
+
+Matrix6d covariance(double sigma_t, double sigma_r) {
+  Matrix6d c = Matrix6d::Zero();
+  c.diagonal() << sigma_t * sigma_t, sigma_t * sigma_t, sigma_t * sigma_t, sigma_r * sigma_r, sigma_r * sigma_r,
+      sigma_r * sigma_r;
+  return c;
+}
+
+}  // namespace
+
+// Nodes merged out of an optimised graph: no kept pose moves, the run between two kept nodes becomes one edge
+// that measures their current relative pose with the chain's summed covariance, and loops of merged nodes go.
+TEST(GraphMerge, ARunOfNodesBecomesOneEdgeAndNoPoseMoves) {
+  const std::vector<Eigen::Isometry3d> truth = squareTruth();
+  PoseGraph graph;
+  OdometryChain chain;
+  Eigen::Isometry3d odometry = truth[0];
+  for (std::size_t k = 0; k < truth.size(); ++k) {
+    Eigen::Isometry3d step = k == 0 ? Eigen::Isometry3d::Identity() : truth[k - 1].inverse() * truth[k];
+    step = step * pose(0.0, 0.0, 0.01);  // a heading drift per step
+    odometry = k == 0 ? truth[0] : odometry * step;
+    const Matrix6d c = covariance(0.02 + 0.001 * static_cast<double>(k), 0.002);
+    chain.add(odometry, c);
+    graph.addNode(odometry);
+    if (k > 0) graph.addOdometryEdge(static_cast<int>(k) - 1, static_cast<int>(k), step, c.inverse());
+  }
+  const int last = graph.size() - 1;
+  graph.addLoopEdge(0, last, Eigen::Isometry3d::Identity(), information(0.05, 0.01));   // the square closes
+  graph.addLoopEdge(10, 50, truth[10].inverse() * truth[50], information(0.05, 0.01));  // across it
+  ASSERT_TRUE(graph.optimize().solved);
+
+  std::vector<bool> keep(static_cast<std::size_t>(graph.size()), true);
+  for (int k = 20; k < 60; ++k) keep[static_cast<std::size_t>(k)] = false;  // removes node 50 and its loop
+  const MergedGraph merged = mergeOutNodes(graph, chain, keep);
+  ASSERT_EQ(merged.graph.size(), graph.size() - 40);
+  ASSERT_EQ(merged.chain.size(), merged.graph.size());
+  EXPECT_EQ(merged.new_index[19], 19);
+  EXPECT_EQ(merged.new_index[30], -1);
+  EXPECT_EQ(merged.new_index[60], 20);
+  for (int k = 0; k < graph.size(); ++k) {
+    const int n = merged.new_index[static_cast<std::size_t>(k)];
+    if (n < 0) continue;
+    EXPECT_TRUE(merged.graph.pose(n).isApprox(graph.pose(k), 1e-12)) << k;
+    EXPECT_TRUE(merged.chain.pose(n).isApprox(chain.pose(k), 1e-12)) << k;
+  }
+  // 19 + 20 odometry edges kept, one across the run, the square's loop; the loop 10 -> 50 went with node 50.
+  int loops = 0, across = 0;
+  for (const PoseGraphEdge& e : merged.graph.edges()) {
+    loops += e.robust ? 1 : 0;
+    if (e.from == 19 && e.to == 20) {
+      ++across;
+      EXPECT_TRUE(e.T_from_to.isApprox(graph.pose(19).inverse() * graph.pose(60), 1e-12));
+      EXPECT_TRUE(e.information.inverse().isApprox(chain.covarianceBetween(19, 60), 1e-9));
+    }
+  }
+  EXPECT_EQ(loops, 1);
+  EXPECT_EQ(across, 1);
+  EXPECT_EQ(static_cast<int>(merged.graph.edges().size()), 19 + 20 + 1 + 1);
+  // The chain's covariance across the merged run is the old one.
+  EXPECT_TRUE(merged.chain.covarianceBetween(10, 25).isApprox(chain.covarianceBetween(10, 65), 1e-9));
+
 }

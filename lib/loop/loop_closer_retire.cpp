@@ -1,0 +1,93 @@
+// Revisit keyframes merged out of the graph (loop.retire_after_keyframes; the graph side in loop/graph_merge.hpp).
+#include "loop/graph_merge.hpp"
+#include "loop/loop_closer.hpp"
+#include "loop/loop_job.hpp"
+
+#include <algorithm>
+
+namespace adit {
+namespace {
+
+// Loops whose two keyframes stay, renumbered; a loop whose query was merged out goes with it.
+void renumber(std::vector<LoopConstraint>& loops, const std::vector<int>& new_index) {
+  std::vector<LoopConstraint> kept;
+  for (LoopConstraint loop : loops) {
+    const int q = new_index[static_cast<std::size_t>(loop.query_index)];
+    const int m = new_index[static_cast<std::size_t>(loop.match_index)];
+    if (q < 0 || m < 0) continue;
+    loop.query_index = q;
+    loop.match_index = m;
+    kept.push_back(loop);
+  }
+  loops = std::move(kept);
+}
+
+template <class T>
+void eraseUnkept(std::vector<T>& items, const std::vector<bool>& keep) {
+  std::size_t out = 0;
+  for (std::size_t k = 0; k < items.size(); ++k)
+    if (keep[k]) {
+      if (out != k) items[out] = std::move(items[k]);  // never onto itself: a self-moved vector is emptied
+      ++out;
+    }
+  items.resize(out);
+}
+
+}  // namespace
+
+// Keyframes without a cloud that are older than the newest retire_after_keyframes (and not held back by
+// keepKeyframesFrom) are merged out once there are retire_batch of them. The loop jobs in flight are applied
+// first (their snapshots name keyframes by index): a fixed point of the input, so replay stays deterministic;
+// the sweep waits for the worker there, once per batch.
+void LoopCloser::retireRevisits(Result& result) {
+  const int n = static_cast<int>(keyframes_.size());
+  const int older_than = n - config_.retire_after_keyframes;
+  if (config_.retire_after_keyframes <= 0 || older_than <= 1) return;
+  const auto retirable = [&](int k) { return clouds_.empty(k) && keyframes_[static_cast<std::size_t>(k)].seq < keep_from_seq_; };
+  int count = 0;
+  for (int k = 1; k < older_than; ++k) count += retirable(k) ? 1 : 0;
+  if (count < config_.retire_batch) return;
+
+  applyDue(0, true, result);
+  std::vector<bool> is_match(static_cast<std::size_t>(n), false);  // never for a keyframe without a cloud: checked anyway
+  for (const std::vector<LoopConstraint>* loops : {&accepted_, &pending_})
+    for (const LoopConstraint& loop : *loops) is_match[static_cast<std::size_t>(loop.match_index)] = true;
+  std::vector<bool> keep(static_cast<std::size_t>(n), true);
+  for (int k = 1; k < older_than; ++k)
+    if (retirable(k) && !is_match[static_cast<std::size_t>(k)]) keep[static_cast<std::size_t>(k)] = false;
+
+  for (int k = 1; k < older_than; ++k) {
+    if (keep[static_cast<std::size_t>(k)]) continue;
+    const Eigen::Isometry3d c = correction(k);
+    const Eigen::Quaterniond q(c.linear());
+    RetiredKeyframe r;
+    r.utime = keyframes_[static_cast<std::size_t>(k)].utime;
+    for (int i = 0; i < 3; ++i) r.translation[i] = static_cast<float>(c.translation()[i]);
+    const double xyzw[4] = {q.x(), q.y(), q.z(), q.w()};
+    for (int i = 0; i < 4; ++i) r.rotation[i] = static_cast<float>(xyzw[i]);
+    retired_.push_back(r);
+    ++stats_.retired_keyframes;
+  }
+  std::stable_sort(retired_.begin(), retired_.end(),
+                   [](const RetiredKeyframe& a, const RetiredKeyframe& b) { return a.utime < b.utime; });
+
+  MergedGraph merged = mergeOutNodes(graph_, chain_, keep);
+  graph_ = std::move(merged.graph);
+  chain_ = std::move(merged.chain);
+  eraseUnkept(keyframes_, keep);
+  eraseUnkept(keypoints_, keep);
+  clouds_.retain(keep);
+  database_.retain(keep);
+  renumber(accepted_, merged.new_index);
+  renumber(pending_, merged.new_index);
+  renumber(result.loops, merged.new_index);
+  result.loop = result.loops.empty() ? std::nullopt : std::optional<LoopConstraint>(result.loops.back());
+  if (last_loop_query_ >= 0) {  // the cooldown counts from the nearest kept keyframe at or before it
+    int q = last_loop_query_;
+    while (q > 0 && merged.new_index[static_cast<std::size_t>(q)] < 0) --q;
+    last_loop_query_ = merged.new_index[static_cast<std::size_t>(q)];
+  }
+  if (scheduler_) scheduler_->replaceBook(LoopBook{accepted_, pending_, last_loop_query_});
+}
+
+}  // namespace adit
