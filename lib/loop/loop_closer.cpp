@@ -297,11 +297,9 @@ Trajectory LoopCloser::correctedTrajectory(const Trajectory& uncorrected) const 
     const std::int64_t next = k < keyframes_.size() ? keyframes_[k].utime : std::numeric_limits<std::int64_t>::max();
     for (; r < retired_.size() && retired_[r].utime < next; ++r) {
       const RetiredKeyframe& x = retired_[r];
-      Eigen::Isometry3d c = Eigen::Isometry3d::Identity();
-      c.linear() = Eigen::Quaterniond(x.rotation[3], x.rotation[0], x.rotation[1], x.rotation[2]).normalized().toRotationMatrix();
-      c.translation() = Eigen::Vector3d(x.translation[0], x.translation[1], x.translation[2]);
+      const int anchor = indexOfKeyframe(x.anchor_seq);  // always in the graph (re-anchored when merged out)
       utimes.push_back(x.utime);
-      corrections.push_back(c);
+      corrections.push_back(anchor >= 0 ? correction(anchor) * x.offset() : x.offset());
     }
     if (k == keyframes_.size()) break;
     utimes.push_back(keyframes_[k].utime);

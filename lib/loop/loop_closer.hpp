@@ -259,11 +259,16 @@ class LoopCloser {
   int last_loop_query_ = -1000000;
   LoopCloserStats stats_;
   std::unique_ptr<LoopScheduler> scheduler_;  // created with the first job
-  // Keyframes merged out of the graph: their correction as it was then, in time order, for correctedTrajectory.
+  // Keyframes merged out of the graph, in time order, for correctedTrajectory: each one's correction relative
+  // to that of a keyframe still in the graph (the nearest older one when it was merged out), so that it moves
+  // with that part of the map when later loops move it. C_this = C_anchor * offset.
   struct RetiredKeyframe {
     std::int64_t utime = 0;
-    float translation[3] = {0, 0, 0};
-    float rotation[4] = {0, 0, 0, 1};  // quaternion x y z w
+    std::int64_t anchor_seq = 0;
+    float translation[3] = {0, 0, 0};  // offset
+    float rotation[4] = {0, 0, 0, 1};  // offset, quaternion x y z w
+    Eigen::Isometry3d offset() const;
+    void setOffset(const Eigen::Isometry3d& offset);
   };
   std::vector<RetiredKeyframe> retired_;
   std::int64_t keep_from_seq_ = std::numeric_limits<std::int64_t>::max();

@@ -4,6 +4,7 @@
 #include "loop/loop_job.hpp"
 
 #include <algorithm>
+#include <map>
 
 namespace adit {
 namespace {
@@ -35,6 +36,20 @@ void eraseUnkept(std::vector<T>& items, const std::vector<bool>& keep) {
 
 }  // namespace
 
+Eigen::Isometry3d LoopCloser::RetiredKeyframe::offset() const {
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = Eigen::Quaterniond(rotation[3], rotation[0], rotation[1], rotation[2]).normalized().toRotationMatrix();
+  T.translation() = Eigen::Vector3d(translation[0], translation[1], translation[2]);
+  return T;
+}
+
+void LoopCloser::RetiredKeyframe::setOffset(const Eigen::Isometry3d& offset) {
+  const Eigen::Quaterniond q(offset.linear());
+  const double xyzw[4] = {q.x(), q.y(), q.z(), q.w()};
+  for (int i = 0; i < 3; ++i) translation[i] = static_cast<float>(offset.translation()[i]);
+  for (int i = 0; i < 4; ++i) rotation[i] = static_cast<float>(xyzw[i]);
+}
+
 // Keyframes without a cloud that are older than the newest retire_after_keyframes (and not held back by
 // keepKeyframesFrom) are merged out once there are retire_batch of them. The loop jobs in flight are applied
 // first (their snapshots name keyframes by index): a fixed point of the input, so replay stays deterministic;
@@ -56,18 +71,33 @@ void LoopCloser::retireRevisits(Result& result) {
   for (int k = 1; k < older_than; ++k)
     if (retirable(k) && !is_match[static_cast<std::size_t>(k)]) keep[static_cast<std::size_t>(k)] = false;
 
+  // Each merged keyframe rides on the nearest older keyframe that stays; those riding on a keyframe merged
+  // out now move onto its anchor.
+  std::map<std::int64_t, std::pair<std::int64_t, Eigen::Isometry3d>> reanchor;  // seq -> anchor seq, offset
+  int anchor = 0;
+  std::vector<RetiredKeyframe> now;
   for (int k = 1; k < older_than; ++k) {
-    if (keep[static_cast<std::size_t>(k)]) continue;
-    const Eigen::Isometry3d c = correction(k);
-    const Eigen::Quaterniond q(c.linear());
+    if (keep[static_cast<std::size_t>(k)]) {
+      anchor = k;
+      continue;
+    }
+    const Keyframe& kf = keyframes_[static_cast<std::size_t>(k)];
+    const Eigen::Isometry3d offset = correction(anchor).inverse() * correction(k);
     RetiredKeyframe r;
-    r.utime = keyframes_[static_cast<std::size_t>(k)].utime;
-    for (int i = 0; i < 3; ++i) r.translation[i] = static_cast<float>(c.translation()[i]);
-    const double xyzw[4] = {q.x(), q.y(), q.z(), q.w()};
-    for (int i = 0; i < 4; ++i) r.rotation[i] = static_cast<float>(xyzw[i]);
-    retired_.push_back(r);
+    r.utime = kf.utime;
+    r.anchor_seq = keyframes_[static_cast<std::size_t>(anchor)].seq;
+    r.setOffset(offset);
+    now.push_back(r);
+    reanchor[kf.seq] = {r.anchor_seq, offset};
     ++stats_.retired_keyframes;
   }
+  for (RetiredKeyframe& r : retired_) {
+    const auto it = reanchor.find(r.anchor_seq);
+    if (it == reanchor.end()) continue;
+    r.anchor_seq = it->second.first;
+    r.setOffset(it->second.second * r.offset());
+  }
+  retired_.insert(retired_.end(), now.begin(), now.end());
   std::stable_sort(retired_.begin(), retired_.end(),
                    [](const RetiredKeyframe& a, const RetiredKeyframe& b) { return a.utime < b.utime; });
 

@@ -60,7 +60,7 @@ std::vector<int*> statFields(LoopCloserStats& s) {
 // Leads the state: a checkpoint of the format before keyframes could be merged out (which began with the
 // keyframe count) is refused rather than misread.
 constexpr std::uint64_t kStateFormat = 0xAD17'0002'0000'0000ULL;
-constexpr std::size_t kRetiredBytes = 8 + 7 * 4;
+constexpr std::size_t kRetiredBytes = 8 + 8 + 7 * 4;
 
 }  // namespace
 
@@ -109,6 +109,7 @@ std::string LoopCloser::saveState() const {
   w.put<std::uint64_t>(retired_.size());
   for (const RetiredKeyframe& x : retired_) {
     w.put<std::int64_t>(x.utime);
+    w.put<std::int64_t>(x.anchor_seq);
     for (float v : x.translation) w.put<float>(v);
     for (float v : x.rotation) w.put<float>(v);
   }
@@ -181,8 +182,10 @@ bool LoopCloser::restoreState(const std::string& state, const std::vector<std::s
   for (std::uint64_t i = 0; i < retired && r.ok(); ++i) {
     RetiredKeyframe x;
     x.utime = r.get<std::int64_t>();
+    x.anchor_seq = r.get<std::int64_t>();
     for (float& v : x.translation) v = r.get<float>();
     for (float& v : x.rotation) v = r.get<float>();
+    if (restored.indexOfKeyframe(x.anchor_seq) < 0) r.fail();  // rides on a keyframe the graph must hold
     restored.retired_.push_back(x);
   }
   if (!r.ok() || !r.atEnd() || restored.stats_.keyframes != static_cast<int>(records)) return false;

@@ -166,6 +166,7 @@ class LoopCloserNode : public runtime::Node, public WritesProducts, public Write
     setCount("loop_wait_ms", static_cast<std::int64_t>(closer_.waitedMs()));
     setCount("keyframes", s.keyframes);
     setCount("revisit_keyframes", s.revisit_keyframes);
+    setCount("retired_keyframes", s.retired_keyframes);
     setCount("loop_candidates", s.candidates);
     setCount("loops_accepted", s.accepted);
     setCount("partial_loops", s.partial_loops);
