@@ -67,8 +67,8 @@ struct LoopCloserConfig {
   // A keyframe without a cloud (a revisit) older than the newest retire_after_keyframes is merged out of the
   // pose graph (loop/graph_merge.hpp), retire_batch at a time: the graph, the odometry chain and the Scan
   // Context database then follow the roadway mapped too, and the keyframe leaves only its final correction
-  // (40 bytes, for the corrected trajectory). Must exceed exclude_recent_keyframes, consistency_window and
-  // revisit_trust_keyframes (their windows count keyframes); 0 keeps every keyframe.
+  // (44 bytes, for the corrected trajectory). Taken as at least one more than exclude_recent_keyframes,
+  // consistency_window and revisit_trust_keyframes (their windows count keyframes); 0 keeps every keyframe.
   int retire_after_keyframes = 200;
   int retire_batch = 50;
 

@@ -1,9 +1,6 @@
 // The loop closer's keys "loop.*": one line each (key, field, allowed range, unit, doc); see core/config_table.hpp.
 #include "loop/loop_closer.hpp"
 
-#include <algorithm>
-#include <string>
-
 namespace adit {
 namespace {
 
@@ -83,7 +80,7 @@ const ConfigTable<LoopCloserConfig>& loopCloserConfigTable() {
      .add("cooldown_keyframes", &K::cooldown_keyframes, between(0, 1000000), "keyframes", "after an accepted loop, skip detection this long")
      .add("revisit_distance", &K::revisit_distance, atLeast(0), "m", "a keyframe this close to an older one, on a trajectory a recent loop ties to it, keeps only its graph node (0: off)")
      .add("revisit_trust_keyframes", &K::revisit_trust_keyframes, between(0, 1000000), "keyframes", "how recent that loop must be")
-     .add("retire_after_keyframes", &K::retire_after_keyframes, between(0, 1000000), "keyframes", "a keyframe without a cloud older than the newest N is merged out of the pose graph (0: never)")
+     .add("retire_after_keyframes", &K::retire_after_keyframes, between(0, 1000000), "keyframes", "a keyframe without a cloud older than the newest N is merged out of the pose graph (0: never; at least one more than the keyframe windows)")
      .add("retire_batch", &K::retire_batch, between(1, 1000000), "keyframes", "keyframes merged out at a time")
      .add("apply_delay_s", &K::apply_delay_s, between(0, 3600), "s", "a loop job's outcome is applied at the first sweep this much later (0: same sweep)")
      .add("worker_thread", &K::worker_thread, anyValue(), "", "verify and optimise on a worker thread (same results either way)")
@@ -109,15 +106,6 @@ const ConfigTable<LoopCloserConfig>& loopCloserConfigTable() {
   return table;
 }
 
-LoopCloserConfig loopCloserConfigFrom(const Config& c) {
-  LoopCloserConfig config = loopCloserConfigTable().read(c);
-  // The windows that count keyframes must not reach a keyframe that may already be merged out.
-  const int window = std::max({config.exclude_recent_keyframes, config.consistency_window, config.revisit_trust_keyframes});
-  if (config.retire_after_keyframes > 0 && config.retire_after_keyframes <= window)
-    throw ConfigError("config: loop.retire_after_keyframes: " + std::to_string(config.retire_after_keyframes) +
-                      " must exceed loop.exclude_recent_keyframes, loop.consistency_window and "
-                      "loop.revisit_trust_keyframes (largest: " + std::to_string(window) + "), or be 0");
-  return config;
-}
+LoopCloserConfig loopCloserConfigFrom(const Config& c) { return loopCloserConfigTable().read(c); }
 
 }  // namespace adit

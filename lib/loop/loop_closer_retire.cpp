@@ -55,9 +55,12 @@ void LoopCloser::RetiredKeyframe::setOffset(const Eigen::Isometry3d& offset) {
 // first (their snapshots name keyframes by index): a fixed point of the input, so replay stays deterministic;
 // the sweep waits for the worker there, once per batch.
 void LoopCloser::retireRevisits(Result& result) {
+  if (config_.retire_after_keyframes <= 0) return;
+  // Never within the windows that count keyframes (loop search exclusion, consistency, revisit trust).
+  const int window = std::max({config_.exclude_recent_keyframes, config_.consistency_window, config_.revisit_trust_keyframes});
   const int n = static_cast<int>(keyframes_.size());
-  const int older_than = n - config_.retire_after_keyframes;
-  if (config_.retire_after_keyframes <= 0 || older_than <= 1) return;
+  const int older_than = n - std::max(config_.retire_after_keyframes, window + 1);
+  if (older_than <= 1) return;
   const auto retirable = [&](int k) { return clouds_.empty(k) && keyframes_[static_cast<std::size_t>(k)].seq < keep_from_seq_; };
   int count = 0;
   for (int k = 1; k < older_than; ++k) count += retirable(k) ? 1 : 0;
