@@ -1,5 +1,7 @@
 #include "loop/keyframe_cloud_store.hpp"
 
+#include "loop/keep_mask.hpp"
+
 #include <fcntl.h>
 #include <unistd.h>
 
@@ -76,19 +78,11 @@ void KeyframeCloudStore::drop(int k) {
 }
 
 void KeyframeCloudStore::retain(const std::vector<bool>& keep) {
-  std::size_t out = 0, next_to_page = 0;
-  for (std::size_t k = 0; k < slots_.size(); ++k) {
-    if (k < keep.size() && !keep[k]) {
-      resident_bytes_ -= slots_[k].cloud.bytes();
-      continue;
-    }
-    if (k < next_to_page_) ++next_to_page;
-    if (out != k) slots_[out] = std::move(slots_[k]);  // never onto itself: a self-moved vector is emptied
-    ++out;
-  }
-  slots_.resize(out);
+  for (std::size_t k = 0; k < slots_.size() && k < keep.size(); ++k)
+    if (!keep[k]) resident_bytes_ -= slots_[k].cloud.bytes();
+  next_to_page_ = keptAmongFirst(keep, next_to_page_);
+  eraseUnkept(slots_, keep);
   slots_.shrink_to_fit();
-  next_to_page_ = next_to_page;
 }
 
 bool KeyframeCloudStore::empty(int k) const { return slots_.at(static_cast<std::size_t>(k)).points == 0; }

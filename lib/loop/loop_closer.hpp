@@ -209,7 +209,6 @@ class LoopCloser {
   // Keyframes numbered seq and later are never merged out (a live process's keyframes not yet in its
   // checkpoint log, whose records must still be written). Default: no limit.
   void keepKeyframesFrom(std::int64_t seq) { keep_from_seq_ = seq; }
-  std::size_t retiredKeyframes() const { return retired_.size(); }
   // Keyframe k's cloud (downsampled, lidar frame; empty for a revisit), from memory or the page file.
   CompactCloud keyframeCloud(int k) const { return clouds_.cloud(k); }
   // Keyframe k's LinK3D keypoints (empty for a revisit or a sweep without them).

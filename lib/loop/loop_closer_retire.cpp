@@ -1,5 +1,6 @@
 // Revisit keyframes merged out of the graph (loop.retire_after_keyframes; the graph side in loop/graph_merge.hpp).
 #include "loop/graph_merge.hpp"
+#include "loop/keep_mask.hpp"
 #include "loop/loop_closer.hpp"
 #include "loop/loop_job.hpp"
 
@@ -21,17 +22,6 @@ void renumber(std::vector<LoopConstraint>& loops, const std::vector<int>& new_in
     kept.push_back(loop);
   }
   loops = std::move(kept);
-}
-
-template <class T>
-void eraseUnkept(std::vector<T>& items, const std::vector<bool>& keep) {
-  std::size_t out = 0;
-  for (std::size_t k = 0; k < items.size(); ++k)
-    if (keep[k]) {
-      if (out != k) items[out] = std::move(items[k]);  // never onto itself: a self-moved vector is emptied
-      ++out;
-    }
-  items.resize(out);
 }
 
 }  // namespace

@@ -1,5 +1,7 @@
 #include "loop/scan_context_database.hpp"
 
+#include "loop/keep_mask.hpp"
+
 #include <nanoflann.hpp>
 
 #include <algorithm>
@@ -42,15 +44,8 @@ int ScanContextDatabase::add(const ScanContext& context, std::int64_t utime) {
 }
 
 void ScanContextDatabase::retain(const std::vector<bool>& keep) {
-  std::size_t out = 0;
-  for (std::size_t i = 0; i < contexts_.size(); ++i) {
-    if (i < keep.size() && !keep[i]) continue;
-    if (out != i) contexts_[out] = std::move(contexts_[i]);  // never onto itself
-    utimes_[out] = utimes_[i];
-    ++out;
-  }
-  contexts_.resize(out);
-  utimes_.resize(out);
+  eraseUnkept(contexts_, keep);
+  eraseUnkept(utimes_, keep);
   contexts_.shrink_to_fit();
   utimes_.shrink_to_fit();
   tree_.reset();
