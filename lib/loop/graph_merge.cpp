@@ -1,5 +1,9 @@
 #include "loop/graph_merge.hpp"
 
+#include "loop/se3.hpp"
+
+#include <Eigen/Cholesky>
+
 namespace adit {
 MergedGraph mergeOutNodes(const PoseGraph& graph, const OdometryChain& chain, std::vector<bool> keep) {
   const int n = graph.size();
@@ -26,14 +30,51 @@ MergedGraph mergeOutNodes(const PoseGraph& graph, const OdometryChain& chain, st
     out.graph.addOdometryEdge(na, nb, graph.pose(a).inverse() * graph.pose(b),
                               chain.covarianceBetween(a, b).inverse());
   }
+  std::vector<int> kept_at_or_before(static_cast<std::size_t>(n), 0);
+  for (int k = 1; k < n; ++k)
+    kept_at_or_before[static_cast<std::size_t>(k)] = keep[static_cast<std::size_t>(k)] ? k : kept_at_or_before[static_cast<std::size_t>(k) - 1];
   for (const PoseGraphEdge& e : graph.edges()) {
     const int from = out.new_index[static_cast<std::size_t>(e.from)], to = out.new_index[static_cast<std::size_t>(e.to)];
-    if (from < 0 || to < 0) continue;
-    PoseGraphEdge copy = e;
-    copy.from = from;
-    copy.to = to;
-    out.graph.addEdge(copy);
+    if (from >= 0 && to >= 0) {
+      PoseGraphEdge copy = e;
+      copy.from = from;
+      copy.to = to;
+      out.graph.addEdge(copy);
+    } else if (e.robust) {
+      const int a = kept_at_or_before[static_cast<std::size_t>(e.from)], b = kept_at_or_before[static_cast<std::size_t>(e.to)];
+      if (std::optional<PoseGraphEdge> moved = reanchoredLoop(graph, chain, e, a, b)) {
+        moved->from = out.new_index[static_cast<std::size_t>(a)];
+        moved->to = out.new_index[static_cast<std::size_t>(b)];
+        out.graph.addEdge(*moved);
+      }
+    }
   }
+  return out;
+}
+
+std::optional<PoseGraphEdge> reanchoredLoop(const PoseGraph& graph, const OdometryChain& chain,
+                                            const PoseGraphEdge& e, int a, int b) {
+  if (a == b || a > e.from || b > e.to) return std::nullopt;
+  const Eigen::LLT<Matrix6d> loop_information(e.information);
+  if (loop_information.info() != Eigen::Success) return std::nullopt;
+  const Eigen::Isometry3d T_a_from = graph.pose(a).inverse() * graph.pose(e.from);
+  const Eigen::Isometry3d T_b_to = graph.pose(b).inverse() * graph.pose(e.to);
+  const Eigen::Isometry3d T_from_b = e.T_from_to * T_b_to.inverse();
+  // Right perturbations moved to the end of T_a_from * Z * T_to_b: X Exp(d) Y = X Y Exp(adjoint(Y^-1) d).
+  // T_b_to's own perturbation enters T_to_b negated on the left, so it lands where Z's does.
+  const Matrix6d A_from = adjoint(T_from_b.inverse());
+  const Matrix6d A_to = adjoint(T_b_to);
+  const Matrix6d covariance = A_from * chain.covarianceBetween(a, e.from) * A_from.transpose() +
+                              A_to * (loop_information.solve(Matrix6d::Identity()) + chain.covarianceBetween(b, e.to)) *
+                                  A_to.transpose();
+  const Eigen::LLT<Matrix6d> llt(0.5 * (covariance + covariance.transpose()));
+  if (llt.info() != Eigen::Success) return std::nullopt;
+  PoseGraphEdge out = e;
+  out.from = a;
+  out.to = b;
+  out.T_from_to = T_a_from * T_from_b;
+  const Matrix6d information = llt.solve(Matrix6d::Identity());
+  out.information = 0.5 * (information + information.transpose());
   return out;
 }
 
