@@ -4,7 +4,21 @@
 
 #include <Eigen/Cholesky>
 
+#include <limits>
+#include <map>
+#include <utility>
+
 namespace adit {
+namespace {
+
+double logDeterminant(const Matrix6d& information) {
+  const Eigen::LLT<Matrix6d> llt(information);
+  if (llt.info() != Eigen::Success) return -std::numeric_limits<double>::infinity();
+  return 2.0 * llt.matrixL().toDenseMatrix().diagonal().array().log().sum();
+}
+
+}  // namespace
+
 MergedGraph mergeOutNodes(const PoseGraph& graph, const OdometryChain& chain, std::vector<bool> keep) {
   const int n = graph.size();
   keep.resize(static_cast<std::size_t>(n), true);
@@ -33,22 +47,34 @@ MergedGraph mergeOutNodes(const PoseGraph& graph, const OdometryChain& chain, st
   std::vector<int> kept_at_or_before(static_cast<std::size_t>(n), 0);
   for (int k = 1; k < n; ++k)
     kept_at_or_before[static_cast<std::size_t>(k)] = keep[static_cast<std::size_t>(k)] ? k : kept_at_or_before[static_cast<std::size_t>(k) - 1];
+  // A moved loop landing on two nodes that another loop already joins keeps the more certain of the two only:
+  // a patrol's revisit loops all land on a few kept nodes, and their errors are the same stretch of chain, so
+  // adding them up would be over-confident; one edge per pair also keeps the graph's size with the map's.
+  std::vector<PoseGraphEdge> edges;
+  std::map<std::pair<int, int>, std::size_t> loop_between;  // (from, to) -> its loop in edges
   for (const PoseGraphEdge& e : graph.edges()) {
-    const int from = out.new_index[static_cast<std::size_t>(e.from)], to = out.new_index[static_cast<std::size_t>(e.to)];
-    if (from >= 0 && to >= 0) {
-      PoseGraphEdge copy = e;
-      copy.from = from;
-      copy.to = to;
-      out.graph.addEdge(copy);
-    } else if (e.robust) {
-      const int a = kept_at_or_before[static_cast<std::size_t>(e.from)], b = kept_at_or_before[static_cast<std::size_t>(e.to)];
-      if (std::optional<PoseGraphEdge> moved = reanchoredLoop(graph, chain, e, a, b)) {
-        moved->from = out.new_index[static_cast<std::size_t>(a)];
-        moved->to = out.new_index[static_cast<std::size_t>(b)];
-        out.graph.addEdge(*moved);
-      }
+    PoseGraphEdge copy = e;
+    copy.from = out.new_index[static_cast<std::size_t>(e.from)];
+    copy.to = out.new_index[static_cast<std::size_t>(e.to)];
+    if (copy.from >= 0 && copy.to >= 0) {
+      if (e.robust) loop_between.emplace(std::make_pair(copy.from, copy.to), edges.size());
+      edges.push_back(copy);
+      continue;
+    }
+    if (!e.robust) continue;
+    const int a = kept_at_or_before[static_cast<std::size_t>(e.from)], b = kept_at_or_before[static_cast<std::size_t>(e.to)];
+    std::optional<PoseGraphEdge> moved = reanchoredLoop(graph, chain, e, a, b);
+    if (!moved) continue;
+    moved->from = out.new_index[static_cast<std::size_t>(a)];
+    moved->to = out.new_index[static_cast<std::size_t>(b)];
+    const auto [it, first] = loop_between.emplace(std::make_pair(moved->from, moved->to), edges.size());
+    if (first) {
+      edges.push_back(*moved);
+    } else if (logDeterminant(moved->information) > logDeterminant(edges[it->second].information)) {
+      edges[it->second] = *moved;
     }
   }
+  for (const PoseGraphEdge& e : edges) out.graph.addEdge(e);
   return out;
 }
 

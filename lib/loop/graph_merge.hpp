@@ -10,8 +10,8 @@
 //     between them knew about the relative pose without those loops, so the edge is never over-confident.
 // A loop edge with a removed end moves that end onto the nearest kept node at or before it, through the
 // graph's current relative pose, its covariance grown by the chain's covariance of that stretch: a revisit's
-// loop still ties its stretch of roadway to the map (a loop whose two ends land on one node goes). Every other
-// edge touching a removed node goes.
+// loop still ties its stretch of roadway to the map (a loop whose two ends land on one node goes; of loops
+// landing on the same two nodes the most certain stays). Every other edge touching a removed node goes.
 #pragma once
 
 #include "loop/odometry_chain.hpp"
