@@ -102,7 +102,10 @@ LoopCloser::Result LoopCloser::process(const PoseEstimate& mapped, const LidarSc
       }
     }
     applyDue(mapped.utime, false, result);
-    if (result.keyframe_added) retireRevisits(result);
+    if (result.keyframe_added) {
+      dropLateRevisit();
+      retireRevisits(result);
+    }
   }
   if (!keyframes_.empty()) result.T_corrected_uncorrected = correction(static_cast<int>(keyframes_.size()) - 1);
   return result;

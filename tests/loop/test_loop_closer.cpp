@@ -3,12 +3,15 @@
 #include "box_world.hpp"
 #include "loop/loop_closer.hpp"
 #include "loop/voxel_filter.hpp"
+#include "map/map_updates.hpp"
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <map>
+#include <set>
 #include <random>
 
 using namespace adit;
@@ -326,6 +329,82 @@ TEST(LoopCloser, APatrolMergesItsRevisitsOutOfTheGraph) {
   restored.finish();
   EXPECT_TRUE(restored.saveState() == live.saveState());
   EXPECT_GT(live.stats().accepted, 0);
+}
+
+// Loops that lapse: with the revisit rule trusting a loop for 2 keyframes only (they close every 3 at best),
+// most keyframes of laps two and three are made while the trust has lapsed and keep their clouds. Once later
+// loops tie them to the first lap they drop them (late revisits) and are merged out too: the graph stays the
+// first lap's size, the corrected trajectory as good as keeping everything, and a checkpoint restores them.
+TEST(LoopCloser, KeyframesMadeWhileLoopsLapseAreMergedOnceTied) {
+  const BoxWorld world = blockLoop();
+  const auto truth = lapPoses(3 * 140 + 10);
+  const auto mapped = drifted(truth, 0.02 * kDeg);
+  LoopCloserConfig lapsing = testConfig(), keep_all = testConfig();
+  lapsing.revisit_trust_keyframes = 2;
+  lapsing.retire_after_keyframes = 60;
+  lapsing.retire_batch = 20;
+  keep_all.retire_after_keyframes = 0;
+  keep_all.revisit_distance = 0;
+  Drive merged{LoopCloser{lapsing}, 0, {}}, all{LoopCloser{keep_all}, 0, {}};
+  drive(merged, world, truth, mapped);
+  drive(all, world, truth, mapped);
+  printStats(merged.closer.stats());
+  const LoopCloserStats& s = merged.closer.stats();
+  const int in_graph = merged.closer.graph().size();
+  std::printf("keyframes %d: %d in the graph, %d merged out, %d revisits of which %d late\n", s.keyframes, in_graph,
+              s.retired_keyframes, s.revisit_keyframes, s.late_revisits);
+  EXPECT_GE(s.late_revisits, 50) << "the trust lapses between most loops";
+  EXPECT_GE(s.retired_keyframes, 150) << "most of laps two and three, late revisits among them";
+  EXPECT_LE(in_graph, 140 + 60 + 20 + 40);
+  EXPECT_EQ(merged.false_loops, 0);
+  expectAsGoodAsKeepingAll(merged.closer, all.closer, mapped, truth, "merging late revisits out");
+  for (int k = 0; k < in_graph; ++k)
+    if (merged.closer.keyframes()[static_cast<std::size_t>(k)].seq < 140)
+      EXPECT_FALSE(merged.closer.clouds().empty(k)) << "the first lap keeps the map, keyframe " << k;
+
+  // A checkpoint after late revisits dropped their clouds: the records (written when the keyframes were made)
+  // still hold them; the state says which were dropped since.
+  LoopCloserConfig same_sweep = lapsing;
+  same_sweep.apply_delay_s = 0;
+  LoopCloser live{same_sweep}, restored{same_sweep};
+  std::vector<std::string> records;
+  MapUpdateTracker updates;  // what a viewer shows: submap number -> has points
+  std::map<int, bool> shown;
+  for (std::size_t k = 0; k < truth.size(); ++k) {
+    PoseEstimate pe;
+    pe.utime = static_cast<std::int64_t>(k) * 1000000;
+    pe.pose = mapped[k];
+    LidarScan scan = simulateSweep(world, truth[k], static_cast<std::uint32_t>(k + 1), 450);
+    scan.utime = pe.utime;
+    live.process(pe, scan);
+    if (const auto update = updates.update(pe.utime, live))
+      for (const NewSubmap& submap : update->added) shown[submap.where.id] = !submap.points.empty();
+    if (live.stats().keyframes > static_cast<int>(records.size()))
+      records.push_back(live.keyframeRecord(static_cast<int>(live.keyframes().size()) - 1));
+    if (k == 330) {
+      ASSERT_GT(live.stats().late_revisits, 0);
+      ASSERT_TRUE(restored.restoreState(live.saveState(), records));
+      EXPECT_TRUE(restored.saveState() == live.saveState());
+      EXPECT_EQ(restored.stats().revisit_keyframes, live.stats().revisit_keyframes);
+      for (int i = 0; i < static_cast<int>(live.keyframes().size()); ++i)
+        EXPECT_EQ(restored.clouds().empty(i), live.clouds().empty(i)) << i;
+    } else if (k > 330) {
+      restored.process(pe, scan);
+    }
+  }
+  live.finish();
+  restored.finish();
+  EXPECT_TRUE(restored.saveState() == live.saveState());
+  // The viewer shows points exactly for the keyframes that keep a cloud: a late revisit's submap was resent empty.
+  std::set<int> with_cloud, with_points;
+  const int sent_up_to = live.stats().keyframes - 5;  // the newest may wait for the next update
+  for (int i = 0; i < static_cast<int>(live.keyframes().size()); ++i) {
+    const int seq = static_cast<int>(live.keyframes()[static_cast<std::size_t>(i)].seq);
+    if (!live.clouds().empty(i) && seq < sent_up_to) with_cloud.insert(seq);
+  }
+  for (const auto& [id, has_points] : shown)
+    if (has_points && id < sent_up_to) with_points.insert(id);
+  EXPECT_EQ(with_points, with_cloud);
 }
 
 TEST(LoopCloser, RejectsAPeriodicRoadway) {
