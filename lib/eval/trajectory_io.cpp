@@ -1,5 +1,7 @@
 #include "eval/trajectory_io.hpp"
 
+#include "io/atomic_file.hpp"
+
 #include <Eigen/SVD>
 
 #include <cinttypes>
@@ -71,20 +73,6 @@ Eigen::Isometry3d poseFrom3x4(const std::vector<double>& v, std::size_t first, c
   return T;
 }
 
-void writeAtomically(const std::string& path, const std::string& content) {
-  const std::string tmp = path + ".tmp";
-  {
-    std::ofstream out(tmp, std::ios::trunc);
-    if (!out) throw std::runtime_error(tmp + ": cannot open for writing");
-    out << content;
-    out.flush();
-    if (!out) throw std::runtime_error(tmp + ": write failed");
-  }
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
-    std::remove(tmp.c_str());
-    throw std::runtime_error(path + ": cannot rename " + tmp + " over it");
-  }
-}
 
 std::string formatSeconds(std::int64_t utime) {
   const bool negative = utime < 0;
@@ -128,7 +116,7 @@ void writeTum(const std::string& path, const Trajectory& trajectory) {
                   q.w());
     content += formatSeconds(p.utime) + buf;
   }
-  writeAtomically(path, content);
+  io::writeFileAtomically(path, content);
 }
 
 Trajectory readKitti(const std::string& path, const std::vector<double>& times, double frame_period_s) {
@@ -162,7 +150,7 @@ void writeKitti(const std::string& path, const Trajectory& trajectory) {
       }
     content += '\n';
   }
-  writeAtomically(path, content);
+  io::writeFileAtomically(path, content);
 }
 
 std::vector<double> readTimes(const std::string& path) {
@@ -208,7 +196,7 @@ Trajectory lidarToCamera(const Trajectory& lidar_poses, const Eigen::Isometry3d&
   return out;
 }
 
-void writeTextFile(const std::string& path, const std::string& content) { writeAtomically(path, content); }
+void writeTextFile(const std::string& path, const std::string& content) { io::writeFileAtomically(path, content); }
 
 TrajectoryFormat detectFormat(const std::string& path) {
   std::ifstream in = openOrThrow(path);

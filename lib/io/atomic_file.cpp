@@ -1,6 +1,7 @@
 #include "io/atomic_file.hpp"
 
 #include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -53,7 +54,26 @@ std::string atomicTempPath(const std::string& path) {
   return path + ".tmp." + std::to_string(static_cast<long>(::getpid()));
 }
 
+bool writesInPlace(const std::string& path) {
+  struct stat st {};
+  return ::stat(path.c_str(), &st) == 0 && !S_ISREG(st.st_mode) && !S_ISDIR(st.st_mode);
+}
+
+namespace {
+
+void writeInPlace(const std::string& path, const std::function<void(std::ostream&)>& write) {
+  std::ofstream out(path, std::ios::binary);
+  if (!out) throw WriteError("cannot open '" + path + "': " + errnoText());
+  errno = 0;
+  write(out);
+  out.flush();
+  if (!out) throw WriteError("write to '" + path + "' failed: " + (errno ? errnoText() : "stream error"));
+}
+
+}  // namespace
+
 void writeFileAtomically(const std::string& path, const std::function<void(std::ostream&)>& write) {
+  if (writesInPlace(path)) return writeInPlace(path, write);
   const std::string tmp = atomicTempPath(path);
   TempFileGuard guard(tmp);
   {

@@ -1,6 +1,9 @@
 // g2o text reading and writing for PoseGraph (the file wrappers are the only file I/O of the loop library).
 #include "loop/pose_graph.hpp"
 
+#include "io/atomic_file.hpp"
+#include "io/io_error.hpp"
+
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -99,15 +102,12 @@ bool readG2o(std::istream& in, PoseGraph& graph) {
 }
 
 bool saveG2o(const PoseGraph& graph, const std::string& path) {
-  const std::string tmp = path + ".tmp";
-  {
-    std::ofstream out(tmp, std::ios::trunc);
-    if (!out) return false;
-    writeG2o(graph, out);
-    out.flush();
-    if (!out) return false;
+  try {
+    io::writeFileAtomically(path, [&graph](std::ostream& out) { writeG2o(graph, out); });
+    return true;
+  } catch (const io::WriteError&) {
+    return false;
   }
-  return std::rename(tmp.c_str(), path.c_str()) == 0;
 }
 
 bool loadG2o(const std::string& path, PoseGraph& graph) {

@@ -1,5 +1,7 @@
 #include "runtime/lcm_log.hpp"
 
+#include "io/atomic_file.hpp"
+
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -115,7 +117,8 @@ bool LogReader::next(LogEvent& event) {
 }
 
 LogWriter::LogWriter(std::string path) : path_(std::move(path)) {
-  tmp_path_ = path_ + ".tmp." + std::to_string(::getpid());
+  in_place_ = io::writesInPlace(path_);  // a device or pipe (/dev/null, a FIFO): never renamed over
+  tmp_path_ = in_place_ ? path_ : io::atomicTempPath(path_);
   file_ = std::fopen(tmp_path_.c_str(), "wb");
   if (!file_) throw std::runtime_error("cannot create log '" + tmp_path_ + "': " + std::strerror(errno));
 }
@@ -126,7 +129,7 @@ void LogWriter::discard() {
   if (!file_) return;
   std::fclose(file_);
   file_ = nullptr;
-  std::remove(tmp_path_.c_str());
+  if (!in_place_) std::remove(tmp_path_.c_str());
 }
 
 void LogWriter::fail(const std::string& what) {
@@ -157,13 +160,14 @@ void LogWriter::write(const std::string& channel, const std::uint8_t* data, std:
 void LogWriter::close() {
   if (!file_) return;
   errno = 0;
-  if (std::fflush(file_) != 0 || ::fsync(::fileno(file_)) != 0) fail("flush failed (disk full?)");
+  if (std::fflush(file_) != 0 || (!in_place_ && ::fsync(::fileno(file_)) != 0)) fail("flush failed (disk full?)");
   std::FILE* file = file_;
   file_ = nullptr;
   if (std::fclose(file) != 0) {
-    std::remove(tmp_path_.c_str());
+    if (!in_place_) std::remove(tmp_path_.c_str());
     throw std::runtime_error("cannot write log '" + path_ + "': close failed: " + std::strerror(errno) + " (nothing written)");
   }
+  if (in_place_) return;
   if (std::rename(tmp_path_.c_str(), path_.c_str()) != 0) {
     const std::string reason = std::strerror(errno);
     std::remove(tmp_path_.c_str());

@@ -48,7 +48,8 @@ class LogReader {
 // Writes to "<path>.tmp.<pid>" and renames onto <path> on close(), so a reader never sees a half log.
 // Every write is checked: on failure (disk full) the temp file is removed and std::runtime_error names
 // the log. A writer destroyed without close() (an exception unwinding) removes its temp file: a log that
-// is not complete never appears under its final name.
+// is not complete never appears under its final name. A device or pipe (/dev/null, a FIFO) is written in
+// place (io::writesInPlace): renaming over it would replace it with a regular file.
 class LogWriter {
  public:
   // Throws std::runtime_error if the file cannot be created.
@@ -71,7 +72,8 @@ class LogWriter {
  private:
   [[noreturn]] void fail(const std::string& what);
   std::string path_;
-  std::string tmp_path_;
+  std::string tmp_path_;  // path_ itself when written in place
+  bool in_place_ = false;
   std::FILE* file_ = nullptr;
   std::int64_t next_event_ = 0;
 };

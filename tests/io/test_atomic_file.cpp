@@ -1,5 +1,9 @@
 #include <gtest/gtest.h>
 
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <stdexcept>
 
 #include "io/atomic_file.hpp"
@@ -18,6 +22,28 @@ TEST(AtomicFile, WritesExactBytesAndLeavesNoTempFile) {
   writeFileAtomically(dir.file("out.bin"), bytes);
   EXPECT_EQ(readAll(dir.file("out.bin")), bytes);
   EXPECT_EQ(dir.entries(), std::vector<std::string>{"out.bin"});
+}
+
+// A named pipe (like /dev/null or /dev/stdout: not a regular file) is written in place and stays a pipe; a
+// rename over it would have replaced it with a regular file.
+TEST(AtomicFile, APipeIsWrittenInPlaceNotReplaced) {
+  TempDir dir;
+  const std::string fifo = dir.file("pipe");
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  EXPECT_TRUE(writesInPlace(fifo));
+  EXPECT_FALSE(writesInPlace(dir.file("absent")));
+  // The reading end first (non-blocking, so a wrong rename fails the test instead of hanging it).
+  const int fd = ::open(fifo.c_str(), O_RDONLY | O_NONBLOCK);
+  ASSERT_GE(fd, 0);
+  writeFileAtomically(fifo, std::string("through the pipe"));
+  char buf[64] = {};
+  const ssize_t got = ::read(fd, buf, sizeof buf);
+  ::close(fd);
+  EXPECT_EQ(std::string(buf, got > 0 ? static_cast<std::size_t>(got) : 0), "through the pipe");
+  struct stat st {};
+  ASSERT_EQ(::stat(fifo.c_str(), &st), 0);
+  EXPECT_TRUE(S_ISFIFO(st.st_mode));
+  EXPECT_EQ(dir.entries(), std::vector<std::string>{"pipe"});
 }
 
 TEST(AtomicFile, ReplacesAnExistingFile) {

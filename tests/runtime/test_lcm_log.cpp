@@ -3,6 +3,8 @@
 
 #include <gtest/gtest.h>
 
+#include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <filesystem>
@@ -105,6 +107,29 @@ TEST(LcmLog, MissingFileThrowsAClearError) {
 
 // A writer abandoned by an exception (a replay that failed half way) leaves nothing behind: no half log
 // under the final name (it used to commit it), no temp file.
+// `-o /dev/null` or a named pipe: written in place; renaming the finished log over it would replace it with
+// a regular file (as root, /dev/null itself). A pipe here, which is safe to get wrong.
+TEST(LcmLog, APipeIsWrittenInPlaceAndStaysAPipe) {
+  const fs::path fifo = tempPath("pipe.lcmlog");
+  fs::remove(fifo);
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  // The reading end first (non-blocking, so a wrong rename fails the test instead of hanging it).
+  const int fd = ::open(fifo.c_str(), O_RDONLY | O_NONBLOCK);
+  ASSERT_GE(fd, 0);
+  {
+    LogWriter w(fifo.string());
+    w.write("A", payload(1), 1);
+    w.close();
+  }
+  char buf[256];
+  const ssize_t got = ::read(fd, buf, sizeof buf);
+  ::close(fd);
+  EXPECT_EQ(got, static_cast<ssize_t>(28 + 1 + payload(1).size())) << "one event: header, channel, payload";
+  EXPECT_TRUE(fs::is_fifo(fifo));
+  EXPECT_FALSE(fs::exists(fifo.string() + ".tmp." + std::to_string(::getpid())));
+  fs::remove(fifo);
+}
+
 TEST(LcmLog, WriterDestroyedWithoutCloseLeavesNothing) {
   const auto path = tempPath("abandoned.lcmlog");
   fs::remove(path);
