@@ -41,10 +41,6 @@ void LoopCloser::RetiredKeyframe::setOffset(const Eigen::Isometry3d& offset) {
   for (int i = 0; i < 4; ++i) rotation[i] = static_cast<float>(xyzw[i]);
 }
 
-// Keyframes without a cloud that are older than the newest retire_after_keyframes (and not held back by
-// keepKeyframesFrom) are merged out once there are retire_batch of them. The loop jobs in flight are applied
-// first (their snapshots name keyframes by index): a fixed point of the input, so replay stays deterministic;
-// the sweep waits for the worker there, once per batch.
 int LoopCloser::retireBefore() const {
   if (config_.retire_after_keyframes <= 0) return 0;
   // Never within the windows that count keyframes (loop search exclusion, consistency, revisit trust).
@@ -53,15 +49,17 @@ int LoopCloser::retireBefore() const {
 }
 
 // The keyframe that just became old enough to merge out, if it kept its cloud only because the revisit rule's
-// trust had lapsed when it was made: a loop whose query lies within revisit_trust_keyframes of it (its own, a
-// later one, or an earlier one applied after it was made) now ties it to the map, and the graph (corrected by that loop) puts it within revisit_distance of an older keyframe that keeps
-// its cloud. It becomes a revisit: the map of the place stays the older keyframe's. Jobs in flight hold their
-// own copies of the clouds they verify against.
+// trust had lapsed when it was made: a loop whose query was made within revisit_trust_keyframes of it (its
+// own, a later one, or an earlier one applied after it was made) now ties it to the map, and the graph
+// (corrected by that loop) puts it within revisit_distance of an older keyframe that keeps its cloud. It
+// becomes a revisit: the map of the place stays the older keyframe's. Jobs in flight hold their own copies of
+// the clouds they verify against.
 void LoopCloser::dropLateRevisit() {
   const int k = retireBefore() - 1;
   if (k < 1 || config_.revisit_distance <= 0 || clouds_.empty(k)) return;
   const bool tied = std::any_of(accepted_.begin(), accepted_.end(), [&](const LoopConstraint& loop) {
-    return std::abs(loop.query_index - k) <= config_.revisit_trust_keyframes;
+    const std::int64_t made = keyframes_[static_cast<std::size_t>(loop.query_index)].seq;  // merging shifts indices
+    return std::abs(made - keyframes_[static_cast<std::size_t>(k)].seq) <= config_.revisit_trust_keyframes;
   });
   if (!tied) return;
   const Eigen::Vector3d here = graph_.pose(k).translation();
@@ -76,6 +74,10 @@ void LoopCloser::dropLateRevisit() {
   ++stats_.late_revisits;
 }
 
+// Keyframes without a cloud that are older than the newest retire_after_keyframes (and not held back by
+// keepKeyframesFrom) are merged out once there are retire_batch of them. The loop jobs in flight are applied
+// first (their snapshots name keyframes by index): a fixed point of the input, so replay stays deterministic;
+// the sweep waits for the worker there, once per batch.
 void LoopCloser::retireRevisits(Result& result) {
   const int older_than = retireBefore();
   if (older_than <= 1) return;
