@@ -8,16 +8,12 @@
 //     merging moves no pose (the loops themselves go with the run: their information is spent), and
 //   - weighted by the odometry chain's covariance of a -> b (the sum of the run's steps): what the keyframes
 //     between them knew about the relative pose without those loops, so the edge is never over-confident.
-// A loop edge with a removed end moves that end onto the nearest kept node at or before it, through the
-// graph's current relative pose, its covariance grown by the chain's covariance of that stretch: a revisit's
-// loop still ties its stretch of roadway to the map (a loop whose two ends land on one node goes; of loops
-// landing on the same two nodes the most certain stays). Every other edge touching a removed node goes.
+// Loop edges with both ends kept are kept; every other edge touching a removed node goes.
 #pragma once
 
 #include "loop/odometry_chain.hpp"
 #include "loop/pose_graph.hpp"
 
-#include <optional>
 #include <vector>
 
 namespace adit {
@@ -31,11 +27,5 @@ struct MergedGraph {
 // keep[k]: node k stays. Node 0 and the newest node always stay (the graph's frame and where the next
 // keyframe attaches); graph and chain must have the same nodes, consecutive nodes joined by odometry edges.
 MergedGraph mergeOutNodes(const PoseGraph& graph, const OdometryChain& chain, std::vector<bool> keep);
-
-// Loop edge e (T_from_to) re-expressed between nodes a <= e.from and b <= e.to of the same chain:
-// T_a_b = (X_a^-1 X_from) * T_from_to * (X_b^-1 X_to)^-1 at the graph's poses, with the chain's covariance of
-// a -> from and b -> to added to the loop's. Nothing if a == b or the loop's information is not invertible.
-std::optional<PoseGraphEdge> reanchoredLoop(const PoseGraph& graph, const OdometryChain& chain,
-                                            const PoseGraphEdge& e, int a, int b);
 
 }  // namespace adit

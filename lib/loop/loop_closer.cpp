@@ -102,10 +102,7 @@ LoopCloser::Result LoopCloser::process(const PoseEstimate& mapped, const LidarSc
       }
     }
     applyDue(mapped.utime, false, result);
-    if (result.keyframe_added) {
-      dropLateRevisit();
-      retireRevisits(result);
-    }
+    if (result.keyframe_added) retireRevisits(result);
   }
   if (!keyframes_.empty()) result.T_corrected_uncorrected = correction(static_cast<int>(keyframes_.size()) - 1);
   return result;

@@ -69,11 +69,6 @@ struct LoopCloserConfig {
   // Context database then follow the roadway mapped too, and the keyframe leaves only its final correction
   // (44 bytes, for the corrected trajectory). Taken as at least one more than exclude_recent_keyframes,
   // consistency_window and revisit_trust_keyframes (their windows count keyframes); 0 keeps every keyframe.
-  // At that age a keyframe that kept its cloud because no loop was recent when it was made (the trust had
-  // lapsed) is looked at again: if a loop accepted within revisit_trust_keyframes after it ties it to the map
-  // and the graph puts it within revisit_distance of an older keyframe with a cloud, it drops its cloud, its
-  // Scan Context and its keypoints then (a late revisit) and is merged out like the others. Without this a
-  // patrol keeps every keyframe made where loops lapse, lap after lap.
   int retire_after_keyframes = 200;
   int retire_batch = 50;
 
@@ -165,7 +160,6 @@ struct LoopCloserStats {
   int rejected_ambiguous = 0;   // two accepted fits in different places, both within the odometry gate
   int contested = 0;            // enough loops agreed but waited: as many waiting loops contradicted them
   int retired_keyframes = 0;    // merged out of the graph (retire_after_keyframes)
-  int late_revisits = 0;        // kept a cloud while trust had lapsed, found a revisit later (of revisit_keyframes)
 };
 
 class LoopScheduler;
@@ -244,9 +238,7 @@ class LoopCloser {
   bool isKeyframe(const Eigen::Isometry3d& pose) const;
   ScanContext addKeyframe(const PoseEstimate& mapped, const LidarScan& cloud, KeyframeKeypointsPtr keypoints);
   bool isRevisit(int keyframe) const;
-  int retireBefore() const;  // keyframes [1, retireBefore()) are old enough to merge out (loop_closer_retire.cpp)
-  void dropLateRevisit();
-  void retireRevisits(Result& result);
+  void retireRevisits(Result& result);  // loop_closer_retire.cpp
   Matrix6d stepCovariance(const Eigen::Isometry3d& new_pose) const;
   void submitJob(int query, const ScanContext& context);
   void applyDue(std::int64_t utime, bool all, Result& result);

@@ -80,7 +80,7 @@ const ConfigTable<LoopCloserConfig>& loopCloserConfigTable() {
      .add("cooldown_keyframes", &K::cooldown_keyframes, between(0, 1000000), "keyframes", "after an accepted loop, skip detection this long")
      .add("revisit_distance", &K::revisit_distance, atLeast(0), "m", "a keyframe this close to an older one, on a trajectory a recent loop ties to it, keeps only its graph node (0: off)")
      .add("revisit_trust_keyframes", &K::revisit_trust_keyframes, between(0, 1000000), "keyframes", "how recent that loop must be")
-     .add("retire_after_keyframes", &K::retire_after_keyframes, between(0, 1000000), "keyframes", "a keyframe without a cloud older than the newest N is merged out of the pose graph, and one that kept its cloud for want of a recent loop drops it then if a loop has tied it since (0: never; at least one more than the keyframe windows)")
+     .add("retire_after_keyframes", &K::retire_after_keyframes, between(0, 1000000), "keyframes", "a keyframe without a cloud older than the newest N is merged out of the pose graph (0: never; at least one more than the keyframe windows)")
      .add("retire_batch", &K::retire_batch, between(1, 1000000), "keyframes", "keyframes merged out at a time")
      .add("apply_delay_s", &K::apply_delay_s, between(0, 3600), "s", "a loop job's outcome is applied at the first sweep this much later (0: same sweep)")
      .add("worker_thread", &K::worker_thread, anyValue(), "", "verify and optimise on a worker thread (same results either way)")

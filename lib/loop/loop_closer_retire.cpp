@@ -5,7 +5,6 @@
 #include "loop/loop_job.hpp"
 
 #include <algorithm>
-#include <cstdlib>
 #include <map>
 
 namespace adit {
@@ -41,59 +40,26 @@ void LoopCloser::RetiredKeyframe::setOffset(const Eigen::Isometry3d& offset) {
   for (int i = 0; i < 4; ++i) rotation[i] = static_cast<float>(xyzw[i]);
 }
 
-int LoopCloser::retireBefore() const {
-  if (config_.retire_after_keyframes <= 0) return 0;
-  // Never within the windows that count keyframes (loop search exclusion, consistency, revisit trust).
-  const int window = std::max({config_.exclude_recent_keyframes, config_.consistency_window, config_.revisit_trust_keyframes});
-  return static_cast<int>(keyframes_.size()) - std::max(config_.retire_after_keyframes, window + 1);
-}
-
-// The keyframe that just became old enough to merge out, if it kept its cloud only because the revisit rule's
-// trust had lapsed when it was made: a loop whose query was made within revisit_trust_keyframes of it (its
-// own, a later one, or an earlier one applied after it was made) now ties it to the map, and the graph
-// (corrected by that loop) puts it within revisit_distance of an older keyframe that keeps its cloud. It
-// becomes a revisit: the map of the place stays the older keyframe's. Jobs in flight hold their own copies of
-// the clouds they verify against.
-void LoopCloser::dropLateRevisit() {
-  const int k = retireBefore() - 1;
-  if (k < 1 || config_.revisit_distance <= 0 || clouds_.empty(k)) return;
-  const bool tied = std::any_of(accepted_.begin(), accepted_.end(), [&](const LoopConstraint& loop) {
-    const std::int64_t made = keyframes_[static_cast<std::size_t>(loop.query_index)].seq;  // merging shifts indices
-    return std::abs(made - keyframes_[static_cast<std::size_t>(k)].seq) <= config_.revisit_trust_keyframes;
-  });
-  if (!tied) return;
-  const Eigen::Vector3d here = graph_.pose(k).translation();
-  bool mapped = false;
-  for (int j = 0; j < k - config_.exclude_recent_keyframes && !mapped; ++j)
-    mapped = !clouds_.empty(j) && (graph_.pose(j).translation() - here).norm() < config_.revisit_distance;
-  if (!mapped) return;
-  clouds_.drop(k);
-  keypoints_[static_cast<std::size_t>(k)].reset();
-  database_.forget(k);
-  ++stats_.revisit_keyframes;
-  ++stats_.late_revisits;
-}
-
 // Keyframes without a cloud that are older than the newest retire_after_keyframes (and not held back by
 // keepKeyframesFrom) are merged out once there are retire_batch of them. The loop jobs in flight are applied
 // first (their snapshots name keyframes by index): a fixed point of the input, so replay stays deterministic;
 // the sweep waits for the worker there, once per batch.
 void LoopCloser::retireRevisits(Result& result) {
-  const int older_than = retireBefore();
-  if (older_than <= 1) return;
+  if (config_.retire_after_keyframes <= 0) return;
+  // Never within the windows that count keyframes (loop search exclusion, consistency, revisit trust).
+  const int window = std::max({config_.exclude_recent_keyframes, config_.consistency_window, config_.revisit_trust_keyframes});
   const int n = static_cast<int>(keyframes_.size());
+  const int older_than = n - std::max(config_.retire_after_keyframes, window + 1);
+  if (older_than <= 1) return;
   const auto retirable = [&](int k) { return clouds_.empty(k) && keyframes_[static_cast<std::size_t>(k)].seq < keep_from_seq_; };
   int count = 0;
   for (int k = 1; k < older_than; ++k) count += retirable(k) ? 1 : 0;
   if (count < config_.retire_batch) return;
 
   applyDue(0, true, result);
-  // The match of a loop whose query is recent stays: the consistency and trust windows read those loops. An
-  // older loop leaves the book with either end (its graph edge is moved onto kept nodes, loop/graph_merge.hpp).
-  std::vector<bool> is_match(static_cast<std::size_t>(n), false);
+  std::vector<bool> is_match(static_cast<std::size_t>(n), false);  // never for a keyframe without a cloud: checked anyway
   for (const std::vector<LoopConstraint>* loops : {&accepted_, &pending_})
-    for (const LoopConstraint& loop : *loops)
-      if (loop.query_index >= older_than) is_match[static_cast<std::size_t>(loop.match_index)] = true;
+    for (const LoopConstraint& loop : *loops) is_match[static_cast<std::size_t>(loop.match_index)] = true;
   std::vector<bool> keep(static_cast<std::size_t>(n), true);
   for (int k = 1; k < older_than; ++k)
     if (retirable(k) && !is_match[static_cast<std::size_t>(k)]) keep[static_cast<std::size_t>(k)] = false;

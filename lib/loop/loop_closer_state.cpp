@@ -54,13 +54,12 @@ std::vector<LoopConstraint> getLoops(ByteReader& r, int keyframes) {
 std::vector<int*> statFields(LoopCloserStats& s) {
   return {&s.sweeps, &s.invalid_sweeps, &s.keyframes, &s.queries, &s.candidates, &s.rejected_fitness,
           &s.rejected_degenerate, &s.rejected_odometry, &s.rejected_pairwise, &s.pending, &s.accepted,
-          &s.optimizations, &s.retired_keyframes, &s.late_revisits};
+          &s.optimizations, &s.retired_keyframes};
 }
 
-// Leads the state: a checkpoint of an older format (before keyframes could be merged out it began with the
-// keyframe count; format 2 did not say which keyframes dropped their cloud after their record was written) is
-// refused rather than misread.
-constexpr std::uint64_t kStateFormat = 0xAD17'0003'0000'0000ULL;
+// Leads the state: a checkpoint of the format before keyframes could be merged out (which began with the
+// keyframe count) is refused rather than misread.
+constexpr std::uint64_t kStateFormat = 0xAD17'0002'0000'0000ULL;
 constexpr std::size_t kRetiredBytes = 8 + 8 + 7 * 4;
 
 }  // namespace
@@ -88,8 +87,6 @@ std::string LoopCloser::saveState() const {
     w.put<std::int64_t>(keyframes_[static_cast<std::size_t>(k)].seq);
     w.putPose(graph_.pose(k));
     w.putMatrix(chain_.stepCovariance(k));
-    // A late revisit's record (written when it was made) still has the cloud it dropped since.
-    w.put<std::uint8_t>(clouds_.empty(k) ? 0 : 1);
   }
   w.put<std::uint64_t>(graph_.edges().size());
   for (const PoseGraphEdge& e : graph_.edges()) {
@@ -132,14 +129,13 @@ bool LoopCloser::restoreState(const std::string& state, const std::vector<std::s
   const std::size_t records = keyframesInState(state);
   r.get<std::uint64_t>();
   r.get<std::uint64_t>();
-  const auto n = r.getCount(8 + 96 + 288 + 1);  // seq, graph pose, step and cloud kept, per keyframe
+  const auto n = r.getCount(8 + 96 + 288);  // seq, graph pose and step per keyframe
   if (!r.ok() || keyframe_records.size() < records || n > records) return false;
   std::int64_t previous_seq = -1;
   for (std::uint64_t k = 0; k < n && r.ok(); ++k) {
     const std::int64_t seq = r.get<std::int64_t>();
     const Eigen::Isometry3d pose = r.getPose();
     const Matrix6d step = r.getMatrix<Matrix6d>();
-    const bool keeps_cloud = r.get<std::uint8_t>() != 0;
     if (!r.ok() || seq <= previous_seq || seq >= static_cast<std::int64_t>(records)) return false;
     previous_seq = seq;
     ByteReader kr(keyframe_records[static_cast<std::size_t>(seq)]);
@@ -154,11 +150,6 @@ bool LoopCloser::restoreState(const std::string& state, const std::vector<std::s
     std::optional<KeyframeKeypoints> keypoints = KeyframeKeypoints();
     if (kr.ok() && !kr.atEnd()) keypoints = KeyframeKeypoints::get(kr);
     if (!kr.ok() || !kr.atEnd() || !keypoints) return false;
-    if (!keeps_cloud && cloud->size() > 0) {  // a late revisit: dropped as KeyframeCloudStore::drop does
-      cloud = CompactCloud::encode({}, cloud->step());
-      context = ScanContext();
-      keypoints = KeyframeKeypoints();
-    }
     restored.chain_.add(kf.uncorrected, step);
     restored.graph_.addNode(pose);
     restored.database_.add(*context, kf.utime);

@@ -53,12 +53,6 @@ void ScanContextDatabase::retain(const std::vector<bool>& keep) {
   if (size() >= rebuild_every_) rebuildTree();
 }
 
-void ScanContextDatabase::forget(int index) {
-  if (index < 0 || index >= size()) return;
-  contexts_[static_cast<std::size_t>(index)] = ScanContext();
-  if (index < tree_size_) rebuildTree();
-}
-
 void ScanContextDatabase::rebuildTree() {
   std::size_t dim = 0;  // of the first real context (a revisit keyframe's is empty)
   for (const ScanContext& c : contexts_)

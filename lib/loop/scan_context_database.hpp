@@ -41,10 +41,6 @@ class ScanContextDatabase {
 
   // Only the entries with keep[i] stay, renumbered in order (keyframes merged out of the graph).
   void retain(const std::vector<bool>& keep);
-  // Entry `index` becomes an empty context (a keyframe found to revisit the map after it was added): it
-  // never matches again, and the ring-key tree is rebuilt if it held it, so the database is the one that
-  // would have had the empty context from the start.
-  void forget(int index);
 
   int size() const { return static_cast<int>(contexts_.size()); }
   const ScanContext& context(int index) const { return contexts_[static_cast<std::size_t>(index)]; }

@@ -37,14 +37,7 @@ std::optional<MapUpdate> MapUpdateTracker::update(std::int64_t utime, const Loop
   std::size_t k = 0, kept = 0;
   for (Sent& sent : sent_) {
     while (k < keyframes.size() && keyframes[k].seq < sent.seq) ++k;
-    const bool merged_out = k == keyframes.size() || keyframes[k].seq != sent.seq;  // never moves again
-    // A late revisit dropped its cloud (and may be merged out already): the viewer replaces it with no points.
-    if (sent.has_points && (merged_out || closer.clouds().empty(static_cast<int>(k)))) {
-      sent.has_points = false;
-      if (!merged_out) sent.pose = graph.pose(static_cast<int>(k));
-      out.added.push_back({{static_cast<int>(sent.seq), sent.utime, sent.pose}, {}});
-    }
-    if (merged_out) continue;
+    if (k == keyframes.size() || keyframes[k].seq != sent.seq) continue;  // merged out: never moves again
     const Eigen::Isometry3d& now = graph.pose(static_cast<int>(k));
     const Eigen::Isometry3d delta = sent.pose.inverse() * now;
     const bool moved = translationNorm(delta) >= config_.move_threshold_m || rotationAngle(delta) >= max_angle;
@@ -64,8 +57,8 @@ std::optional<MapUpdate> MapUpdateTracker::update(std::int64_t utime, const Loop
     if (!out.added.empty() && points + decimated.size() > static_cast<std::size_t>(config_.max_points)) break;
     points += decimated.size();
     const Eigen::Isometry3d pose = graph.pose(static_cast<int>(k));
-    sent_.push_back({keyframes[k].seq, keyframes[k].utime, pose, !decimated.empty()});
     out.added.push_back({{static_cast<int>(keyframes[k].seq), keyframes[k].utime, pose}, std::move(decimated)});
+    sent_.push_back({keyframes[k].seq, pose});
     next_seq_ = keyframes[k].seq + 1;
   }
   if (out.added.empty() && out.moved.empty()) return std::nullopt;

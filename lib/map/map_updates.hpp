@@ -55,9 +55,7 @@ class MapUpdateTracker {
   MapUpdateConfig config_;
   struct Sent {
     std::int64_t seq = 0;
-    std::int64_t utime = 0;
     Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();  // as last sent
-    bool has_points = false;  // sent with points: resent empty if the keyframe drops its cloud (a late revisit)
   };
   std::vector<Sent> sent_;  // by seq; a keyframe merged out of the graph is forgotten
   std::int64_t next_seq_ = 0;  // the first keyframe not sent yet

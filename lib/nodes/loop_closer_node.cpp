@@ -167,7 +167,6 @@ class LoopCloserNode : public runtime::Node, public WritesProducts, public Write
     setCount("keyframes", s.keyframes);
     setCount("revisit_keyframes", s.revisit_keyframes);
     setCount("retired_keyframes", s.retired_keyframes);
-    setCount("late_revisits", s.late_revisits);
     setCount("loop_candidates", s.candidates);
     setCount("loops_accepted", s.accepted);
     setCount("partial_loops", s.partial_loops);
