@@ -73,7 +73,6 @@ Eigen::Isometry3d poseFrom3x4(const std::vector<double>& v, std::size_t first, c
   return T;
 }
 
-
 std::string formatSeconds(std::int64_t utime) {
   const bool negative = utime < 0;
   const std::uint64_t magnitude = negative ? static_cast<std::uint64_t>(-(utime + 1)) + 1u : static_cast<std::uint64_t>(utime);

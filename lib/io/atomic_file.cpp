@@ -61,32 +61,26 @@ bool writesInPlace(const std::string& path) {
 
 namespace {
 
-void writeInPlace(const std::string& path, const std::function<void(std::ostream&)>& write) {
-  std::ofstream out(path, std::ios::binary);
-  if (!out) throw WriteError("cannot open '" + path + "': " + errnoText());
-  errno = 0;
+// Opens `file` (created or truncated) and lets `write` fill it; WriteError names the file on any failure.
+void streamTo(const std::string& file, const std::function<void(std::ostream&)>& write) {
+  std::ofstream out(file, std::ios::binary | std::ios::trunc);
+  if (!out) throw WriteError("cannot create '" + file + "': " + errnoText());
+  errno = 0;  // a failed stream keeps no error code; the failed write(2) behind it left one in errno
   write(out);
   out.flush();
-  if (!out) throw WriteError("write to '" + path + "' failed: " + (errno ? errnoText() : "stream error"));
+  if (!out) {
+    const int error = errno;
+    throw WriteError("write to '" + file + "' failed: " + (error ? std::strerror(error) : "stream error (disk full?)"));
+  }
 }
 
 }  // namespace
 
 void writeFileAtomically(const std::string& path, const std::function<void(std::ostream&)>& write) {
-  if (writesInPlace(path)) return writeInPlace(path, write);
+  if (writesInPlace(path)) return streamTo(path, write);
   const std::string tmp = atomicTempPath(path);
   TempFileGuard guard(tmp);
-  {
-    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    if (!out) throw WriteError("cannot create '" + tmp + "': " + errnoText());
-    errno = 0;  // a failed stream keeps no error code; the failed write(2) behind it left one in errno
-    write(out);
-    out.flush();
-    if (!out) {
-      const int error = errno;
-      throw WriteError("write to '" + tmp + "' failed: " + (error ? std::strerror(error) : "stream error (disk full?)"));
-    }
-  }
+  streamTo(tmp, write);
   if (!fsyncPath(tmp, O_RDONLY)) throw WriteError("fsync of '" + tmp + "' failed: " + errnoText());
   if (std::rename(tmp.c_str(), path.c_str()) != 0)
     throw WriteError("cannot rename '" + tmp + "' to '" + path + "': " + errnoText());
