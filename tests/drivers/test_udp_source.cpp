@@ -3,14 +3,11 @@
 // encoded point_cloud_t messages. Bounded: a fixed number of packets, then the source's idle timeout ends it.
 #include "drivers/lidar_stream.hpp"
 #include "drivers/udp_lidar_source.hpp"
+#include "drivers/udp_sender.hpp"
 #include "msg/convert.hpp"
 #include "msg/sweep_codec.hpp"
 #include "synthetic_lidar.hpp"
 
-#include <arpa/inet.h>
-#include <netinet/in.h>
-#include <sys/socket.h>
-#include <unistd.h>
 
 #include <gtest/gtest.h>
 
@@ -29,20 +26,14 @@ using testing::SyntheticLidar;
 // Sends `packets` to 127.0.0.1:port, one every `spacing` (a real VLP-16 sends one per 1.33 ms).
 void sendPackets(const std::vector<std::vector<std::uint8_t>>& packets, std::uint16_t port,
                  std::chrono::microseconds spacing) {
-  const int fd = socket(AF_INET, SOCK_DGRAM, 0);
-  ASSERT_GE(fd, 0);
-  sockaddr_in to{};
-  to.sin_family = AF_INET;
-  to.sin_port = htons(port);
-  to.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  UdpSender sender("127.0.0.1", port);
   auto due = std::chrono::steady_clock::now();
   for (const auto& p : packets) {
     std::this_thread::sleep_until(due);
     due += spacing;
-    ASSERT_EQ(sendto(fd, p.data(), p.size(), 0, reinterpret_cast<const sockaddr*>(&to), sizeof(to)),
-              static_cast<ssize_t>(p.size()));
+    std::string error;
+    ASSERT_TRUE(sender.send(p.data(), p.size(), error)) << error;
   }
-  close(fd);
 }
 
 // Binds the source on random high ports (another program may hold one, so try a few); RS-16: the DIFOP
@@ -230,6 +221,24 @@ TEST(UdpLidarSource, ConfigKeys) {
   UdpLidarConfig rs;
   rs.model = "rs16";
   EXPECT_EQ(dataPortOf(rs), 6699);
+}
+
+}  // namespace
+}  // namespace adit::drivers
+
+namespace adit::drivers {
+namespace {
+
+TEST(UdpSender, AddressesAreIpv4HostAndPort) {
+  std::string host;
+  std::uint16_t port = 0;
+  parseUdpAddress("127.0.0.1:2368", host, port);
+  EXPECT_EQ(host, "127.0.0.1");
+  EXPECT_EQ(port, 2368);
+  for (const char* bad : {"127.0.0.1", ":2368", "127.0.0.1:", "127.0.0.1:0", "127.0.0.1:65536", "127.0.0.1:23x",
+                          "localhost:2368", "127.0.0.1:2368:1"})
+    EXPECT_THROW(parseUdpAddress(bad, host, port), std::invalid_argument) << bad;
+  EXPECT_THROW(UdpSender("not-an-address", 2368), std::runtime_error);
 }
 
 }  // namespace
