@@ -7,6 +7,8 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <cmath>
+#include <cstdlib>
 #include <memory>
 #include <stdexcept>
 
@@ -166,11 +168,29 @@ void LidarPacketStream::push(const std::uint8_t* data, std::size_t size, std::in
                              "host on UTC (GPS/PPS, chrony); use 'sensor' for a free-running clock", packet_.stamp_us);
   }
   placed_any_ = true;
+  countLostPackets(t->first_firing_ns);
   health_.last_input_utime = t->first_firing_ns / 1000;
   const std::size_t before = sweeps.size();
   assembler_.add(packet_, t->first_firing_ns, sweeps);
   health_.outputs += static_cast<std::int64_t>(sweeps.size() - before);
   syncSweepCounters();
+}
+
+void LidarPacketStream::countLostPackets(std::int64_t first_firing_ns) {
+  const std::int64_t spacing = last_first_ns_ < 0 ? 0 : first_firing_ns - last_first_ns_;
+  last_first_ns_ = first_firing_ns;
+  if (spacing <= 0) return;
+  // Two equal spacings in a row (to 1 %) are the period or a multiple of it: the smallest such is the period.
+  // A single odd spacing (a hole, a shifted clock) never sets it.
+  if (last_spacing_ns_ > 0 && std::llabs(spacing - last_spacing_ns_) * 100 <= spacing &&
+      (period_ns_ == 0 || spacing < period_ns_))
+    period_ns_ = spacing;
+  last_spacing_ns_ = spacing;
+  // Longer holes restart the sweep and are counted as packet_gap by the assembler.
+  const auto max_gap_ns = static_cast<std::int64_t>(config_.sweep.max_firing_gap_s * 1e9);
+  if (period_ns_ == 0 || 2 * spacing < 3 * period_ns_ || spacing > max_gap_ns) return;
+  health_.counters["lost_packets"] +=
+      std::llround(static_cast<double>(spacing) / static_cast<double>(period_ns_)) - 1;
 }
 
 void LidarPacketStream::finish(std::vector<LidarScan>& sweeps) {

@@ -51,7 +51,10 @@ struct LidarStreamConfig {
 //     unknown_product, unknown_return_mode;
 //   skipped packets (Health::drops): time_backwards;
 //   sweeps not published (Health::drops): partial_sweep, sweep_too_long;
-//   events: packet_gap, time_reanchor, time_shifted, clock_not_utc, empty_sweep, partial_sweep_published.
+//   events: packet_gap, time_reanchor, time_shifted, clock_not_utc, empty_sweep, partial_sweep_published;
+//   lost_packets: packets missing from the stream in holes shorter than a packet_gap (lost on the link, or
+//     come too late and skipped as time_backwards), from the spacing of the stamps: the packet period is the
+//     smallest spacing seen twice in a row, and a hole of k periods is k - 1 lost packets.
 class LidarPacketStream {
  public:
   // Throws std::invalid_argument on a bad elevation table.
@@ -80,6 +83,7 @@ class LidarPacketStream {
   void syncSweepCounters();
 
   void makeDecoder(const std::array<double, kBeams>& elevations, bool dual_return);
+  void countLostPackets(std::int64_t first_firing_ns);
 
   LidarStreamConfig config_;
   std::array<double, kBeams> elevations_{};
@@ -92,6 +96,7 @@ class LidarPacketStream {
   PacketClock clock_;
   SweepAssembler assembler_;
   DecodedPacket packet_;  // reused between packets
+  std::int64_t last_first_ns_ = -1, last_spacing_ns_ = 0, period_ns_ = 0;  // lost_packets
   msg::FiringTable firing_table_;
   runtime::Health health_;
 };

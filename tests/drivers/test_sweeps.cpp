@@ -294,12 +294,28 @@ TEST(SweepAssembler, LostPacketsDropTheSweepTheyHit) {
     if (k < 130 || k >= 140) order.push_back(k);  // 10 packets (13 ms) lost in the 2nd full revolution
   const StreamRun run = feed(lidar, order, streamConfig(lidar));
   EXPECT_EQ(run.health.counters.at("packet_gap"), 1);
+  EXPECT_EQ(run.health.counters.count("lost_packets"), 0u);  // a hole this long is a gap, not lost packets
   EXPECT_EQ(run.health.counters.at("partial_sweep"), 2);
   ASSERT_EQ(run.sweeps.size(), 2u);
   const StreamRun clean = feed(lidar, range(kPackets), streamConfig(lidar));
   EXPECT_EQ(run.sweeps[0].utime, clean.sweeps[0].utime);  // before the gap
   EXPECT_EQ(run.sweeps[1].utime, clean.sweeps[2].utime);  // after it
   EXPECT_EQ(run.sweeps[1].seq, 1);
+}
+
+TEST(LidarPacketStream, SingleLostPacketsAreCountedAndTheirSweepsKept) {
+  SyntheticLidar lidar;
+  const std::vector<int> lost = {50, 51, 90, 200, 202};  // a pair, single ones, two a packet apart
+  std::vector<int> order;
+  for (int k = 0; k < kPackets; ++k)
+    if (std::find(lost.begin(), lost.end(), k) == lost.end()) order.push_back(k);
+  const StreamRun run = feed(lidar, order, streamConfig(lidar));
+  const StreamRun clean = feed(lidar, range(kPackets), streamConfig(lidar));
+  EXPECT_EQ(run.health.counters.at("lost_packets"), 5);
+  EXPECT_EQ(clean.health.counters.count("lost_packets"), 0u);
+  EXPECT_EQ(run.health.counters.at("packet_gap"), 0);
+  ASSERT_EQ(run.sweeps.size(), clean.sweeps.size());  // small holes: every sweep is still published
+  for (std::size_t i = 0; i < run.sweeps.size(); ++i) EXPECT_EQ(run.sweeps[i].utime, clean.sweeps[i].utime);
 }
 
 TEST(SweepAssembler, StalledHeadPublishesNothing) {
