@@ -8,6 +8,7 @@
 #include <spdlog/spdlog.h>
 
 #include <chrono>
+#include <stdexcept>
 #include <thread>
 
 namespace adit::runtime {
@@ -20,6 +21,7 @@ int writeLog(MessageSource& source, const SourceRunOptions& options) {
   LogWriter log(options.output_log);
   OutgoingMessage m;
   while (!stopRequested() && source.next(m)) {
+    if (m.send) throw std::logic_error("a message sent by its own means (not on LCM) cannot be written to a log");
     if (source.health().errors > 0 && !options.keep_going) break;
     log.write(m.channel, m.data, m.utime);
   }
@@ -83,8 +85,12 @@ int publishLive(MessageSource& source, const SourceRunOptions& options) {
         if (Clock::now() - last_status >= std::chrono::duration<double>(options.status_period_s)) sendStatus("running");
       }
     }
-    lcm.publish(m.channel, m.data.data(), static_cast<unsigned int>(m.data.size()));
-    traffic.add(m.channel, m.data.size());
+    if (m.send) {
+      m.send();
+    } else {
+      lcm.publish(m.channel, m.data.data(), static_cast<unsigned int>(m.data.size()));
+      traffic.add(m.channel, m.data.size());
+    }
     ++published;
     if (Clock::now() - last_status >= std::chrono::duration<double>(options.status_period_s)) sendStatus("running");
   }

@@ -15,6 +15,9 @@ struct OutgoingMessage {
   std::string channel;
   Bytes data;
   std::int64_t utime = 0;  // sensor time: paces live publishing and stamps log events
+  // Live only: at the message's due time this is called instead of publishing `data` on LCM (the simulated
+  // lidar's own UDP packets, `adit sim --lidar-udp`). A source that sets it cannot write a log.
+  std::function<void()> send = nullptr;
 };
 
 class MessageSource {

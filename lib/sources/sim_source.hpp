@@ -45,6 +45,7 @@ class SimSource : public runtime::MessageSource {
   double progress() const override;
 
   const sim::Simulator& simulator() const { return simulator_; }
+  const SimChannels& channels() const { return channels_; }
   // Each observer is called with every sweep / IMU sample as it is published, in the order added (e.g. to
   // also write the run as sensor packets, `--pcap`, or as a bag, `--bag`).
   void addSweepObserver(std::function<void(const LidarScan&)> observer) { sweep_observers_.push_back(std::move(observer)); }

@@ -5,7 +5,9 @@
 #include "io/pcd.hpp"
 #include "runtime/process.hpp"
 #include "io/atomic_file.hpp"
+#include "drivers/udp_sender.hpp"
 #include "sources/sim_bag.hpp"
+#include "sources/sim_lidar_udp.hpp"
 #include "sources/sim_pcap.hpp"
 #include "sources/sim_source.hpp"
 
@@ -16,7 +18,7 @@ namespace {
 
 struct SimArgs {
   std::vector<std::string> configs;
-  std::string world, sensor, output, gt, world_pcd, lcm_url, pcap, bag, bag_compression = "none";
+  std::string world, sensor, output, gt, world_pcd, lcm_url, pcap, bag, bag_compression = "none", lidar_udp;
   double duration_s = -1, rate = 1.0, world_spacing = 0.1, start_speed = -1, start_distance = -1;
   bool reverse = false, stationary = false;
   std::int64_t seed = -1;
@@ -52,16 +54,17 @@ struct Recording {
   std::function<void()> done;
 };
 
-// Runs the source with every recording open, each written atomically: a failed run leaves none of them.
-void runRecording(adit::sources::SimSource& source, const adit::runtime::SourceRunOptions& run,
-                  const std::vector<Recording>& files, std::size_t i = 0) {
+// Runs `source` (the simulator, or what wraps it) with every recording of `sim` open, each written atomically:
+// a failed run leaves none of them.
+void runRecording(adit::sources::SimSource& sim, adit::runtime::MessageSource& source,
+                  const adit::runtime::SourceRunOptions& run, const std::vector<Recording>& files, std::size_t i = 0) {
   if (i == files.size()) {
     if (const int code = adit::runtime::runSource(source, run); code != 0) throw CLI::RuntimeError(code);
     return;
   }
   adit::io::writeFileAtomically(files[i].path, [&](std::ostream& out) {
-    const std::function<void()> complete = files[i].attach(source, out);
-    runRecording(source, run, files, i + 1);
+    const std::function<void()> complete = files[i].attach(sim, out);
+    runRecording(sim, source, run, files, i + 1);
     complete();
   });
   files[i].done();
@@ -91,6 +94,10 @@ void registerSimCommand(CLI::App& app) {
   cmd->add_flag("--live", a->live, "Publish over LCM in real time instead of writing a log");
   cmd->add_option("--rate", a->rate, "With --live: multiple of real time (0 = as fast as possible)")->check(CLI::NonNegativeNumber);
   cmd->add_option("--lcm-url", a->lcm_url, "With --live: LCM provider (default: $LCM_DEFAULT_URL or udpm)");
+  cmd->add_option("--lidar-udp", a->lidar_udp,
+                  "With --live (vlp16, rate 1): send the lidar as VLP-16 UDP packets to HOST:PORT instead of "
+                  "LIDAR_POINTS, for adit-lidar-bridge (launch/sim-packets.launch.yaml); the clock starts at the "
+                  "wall clock, as the packets' stamps are UTC");
   cmd->add_flag("--no-ground-truth-channel", a->no_truth_channel, "Do not publish GROUND_TRUTH");
   cmd->add_option("--start-speed", a->start_speed,
                   "Already driving at this speed (m/s) at time 0, as a log cut from a drive (sim.motion.start_speed; "
@@ -112,6 +119,17 @@ void registerSimCommand(CLI::App& app) {
   cmd->add_option("--stall-imu", a->stall_imu, "Fault test: publish no IMU from START for SECONDS (START:SECONDS)");
   cmd->callback([a] {
     if (a->live == !a->output.empty()) throw CLI::ValidationError("adit sim", "give either -o LOG or --live");
+    std::string udp_host;
+    std::uint16_t udp_port = 0;
+    if (!a->lidar_udp.empty()) {
+      if (!a->live || a->rate != 1.0)
+        throw CLI::ValidationError("--lidar-udp", "needs --live at --rate 1 (the packets' stamps are UTC)");
+      try {
+        adit::drivers::parseUdpAddress(a->lidar_udp, udp_host, udp_port);
+      } catch (const std::invalid_argument& e) {
+        throw CLI::ValidationError("--lidar-udp", e.what());
+      }
+    }
     // The flags go into the configuration before it is resolved: the world's geometry depends on the world's
     // name and the seed (a --world set afterwards used to build the file's or the default world).
     adit::Config file = adit::runtime::loadConfig(a->configs);
@@ -125,6 +143,8 @@ void registerSimCommand(CLI::App& app) {
     if (a->start_distance >= 0) config.motion.start_distance = a->start_distance;
     if (a->reverse) config.motion.reverse = true;
     if (a->stationary) config.motion.stationary = true;
+    // A sensor's packets carry UTC stamps: the simulated clock is the host's, to the millisecond.
+    if (!a->lidar_udp.empty()) config.start_utime = adit::runtime::wallUtime() / 1000 * 1000;
 
     adit::sources::SimChannels channels;
     if (a->no_truth_channel) channels.ground_truth.clear();
@@ -172,7 +192,13 @@ void registerSimCommand(CLI::App& app) {
                        },
                        [messages, path = a->bag] { fmt::print("sim: wrote {} bag messages to {}\n", *messages, path); }});
     }
-    runRecording(source, run, files);
+    if (a->lidar_udp.empty()) {
+      runRecording(source, source, run, files);
+    } else {
+      adit::sources::SimLidarUdpSource link(source, udp_host, udp_port);
+      fmt::print("sim: lidar as VLP-16 packets to {}\n", a->lidar_udp);
+      runRecording(source, link, run, files);
+    }
     if (!a->gt.empty()) {
       adit::eval::writeTum(a->gt, source.groundTruth());
       fmt::print("sim: wrote ground truth ({} poses) to {}\n", source.groundTruth().size(), a->gt);
