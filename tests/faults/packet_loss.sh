@@ -2,7 +2,8 @@
 # Packet loss on the bus: the simulated live pipeline (launch/sim.launch.yaml) twice in a private network
 # namespace, once loss-free and once with a fraction of the IP packets on the loopback dropped at random
 # (nftables; netem where the kernel has it is not needed). The loopback's MTU is set to Ethernet's 1500, so a
-# ~0.6 MB sweep travels as ~430 IP fragments and one lost fragment loses the whole sweep, as on a real LAN.
+# ~0.1 MB sweep travels as ~70 IP fragments and one lost fragment loses the whole sweep, as on a real LAN (loss
+# on the sensors' own links, where a robot meets it: sensor_link_loss.sh).
 # Checks: drops are counted on STATUS (lost_input), no process restarts or stops publishing STATUS, the run
 # ends as planned, and the APE of ODOM_MAPPED against the simulator's ground truth stays within 20 % (+2 cm
 # for run-to-run noise at real time) of the loss-free run.
