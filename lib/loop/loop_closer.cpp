@@ -97,7 +97,6 @@ LoopCloser::Result LoopCloser::process(const PoseEstimate& mapped, const LidarSc
       submitJob(k, context);  // the job keeps its own copy of the cloud and keypoints
       if (revisit) {
         clouds_.drop(k);
-        keypoints_[static_cast<std::size_t>(k)].reset();
         ++stats_.revisit_keyframes;
       }
     }
@@ -138,7 +137,7 @@ void LoopCloser::submitJob(int query, const ScanContext& context) {
          j <= std::min(newest_allowed, m + config_.verifier.submap_neighbors); ++j) {
       snap.neighbourhood.clouds.push_back(clouds_.cloud(j));
       snap.neighbourhood.T_match_cloud.push_back(T_m_world * graph_.pose(j));
-      if (config_.keypoints.use) snap.neighbourhood_keypoints.push_back(keypoints_[static_cast<std::size_t>(j)]);
+      if (config_.keypoints.use) snap.neighbourhood_keypoints.push_back(clouds_.keypoints(j));
     }
     job.candidates.push_back(std::move(snap));
   }
@@ -150,7 +149,7 @@ void LoopCloser::submitJob(int query, const ScanContext& context) {
   job.query_utime = q.utime;
   job.query_uncorrected = q.uncorrected;
   job.query_cloud = clouds_.cloud(query);
-  if (config_.keypoints.use) job.query_keypoints = keypoints_[static_cast<std::size_t>(query)];
+  if (config_.keypoints.use) job.query_keypoints = clouds_.keypoints(query);
   job.graph = graph_;
   job.chain = chain_;
   job.applied_loops = accepted_.size();
@@ -263,18 +262,22 @@ ScanContext LoopCloser::addKeyframe(const PoseEstimate& mapped, const LidarScan&
   }
   sweeps_since_keyframe_.clear();
   keyframes_.push_back(std::move(kf));
+  if (!config_.keypoints.use) keypoints.reset();
   clouds_.add(CompactCloud::encode(voxelDownsample(points, config_.keyframe_voxel),
-                                   static_cast<float>(config_.keyframe_cloud_step)));
-  if (!config_.keypoints.use || (keypoints && keypoints->empty())) keypoints.reset();
-  keypoints_.push_back(std::move(keypoints));
+                                   static_cast<float>(config_.keyframe_cloud_step)),
+              std::move(keypoints));
   ++stats_.keyframes;
   return keyframeScanContext(std::move(points), mapped.pose, config_.level_scan_context, config_.scan_context);
 }
 
-const KeyframeKeypoints& LoopCloser::keyframeKeypoints(int k) const {
-  static const KeyframeKeypoints kNone;
-  const KeyframeKeypointsPtr& p = keypoints_[static_cast<std::size_t>(k)];
-  return p ? *p : kNone;
+KeyframeKeypoints LoopCloser::keyframeKeypoints(int k) const {
+  const KeyframeKeypointsPtr p = clouds_.keypoints(k);
+  return p ? *p : KeyframeKeypoints();
+}
+
+void LoopCloser::pageKeyframesTo(const std::string& path, std::size_t resident) {
+  clouds_.pageTo(path, resident);
+  database_.pageTo(path + ".sc", resident);
 }
 
 Eigen::Isometry3d LoopCloser::correction(int keyframe) const {

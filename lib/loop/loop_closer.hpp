@@ -212,13 +212,15 @@ class LoopCloser {
   // Keyframe k's cloud (downsampled, lidar frame; empty for a revisit), from memory or the page file.
   CompactCloud keyframeCloud(int k) const { return clouds_.cloud(k); }
   // Keyframe k's LinK3D keypoints (empty for a revisit or a sweep without them).
-  const KeyframeKeypoints& keyframeKeypoints(int k) const;
-  // A live process's memory: all but the newest `resident` keyframe clouds go to a page file
-  // (loop/keyframe_cloud_store.hpp). Throws std::runtime_error if the file cannot be created.
-  void pageCloudsTo(const std::string& path, std::size_t resident) { clouds_.pageTo(path, resident); }
+  KeyframeKeypoints keyframeKeypoints(int k) const;
+  // A live process's memory: the clouds and keypoints of all but the newest `resident` keyframes go to a page
+  // file (loop/keyframe_cloud_store.hpp), their Scan Contexts to another (path + ".sc",
+  // loop/scan_context_database.hpp). Throws std::runtime_error if a file cannot be created.
+  void pageKeyframesTo(const std::string& path, std::size_t resident);
   const KeyframeCloudStore& clouds() const { return clouds_; }
+  const ScanContextDatabase& contexts() const { return database_; }
   const PoseGraph& graph() const { return graph_; }
-  const ScanContext& keyframeContext(int keyframe) const { return database_.context(keyframe); }
+  ScanContext keyframeContext(int keyframe) const { return database_.context(keyframe); }
   const std::vector<LoopConstraint>& acceptedLoops() const { return accepted_; }
   const LoopCloserStats& stats() const { return stats_; }
   const LoopCloserConfig& config() const { return config_; }
@@ -246,8 +248,7 @@ class LoopCloser {
 
   LoopCloserConfig config_;
   std::vector<Keyframe> keyframes_;
-  KeyframeCloudStore clouds_;  // [k]: keyframe k's cloud
-  std::vector<KeyframeKeypointsPtr> keypoints_;  // [k]: keyframe k's LinK3D keypoints or null (dropped with its cloud)
+  KeyframeCloudStore clouds_;  // [k]: keyframe k's cloud and LinK3D keypoints (dropped together for a revisit)
   OdometryChain chain_;
   PoseGraph graph_;
   ScanContextDatabase database_;

@@ -98,7 +98,6 @@ void LoopCloser::retireRevisits(Result& result) {
   graph_ = std::move(merged.graph);
   chain_ = std::move(merged.chain);
   eraseUnkept(keyframes_, keep);
-  eraseUnkept(keypoints_, keep);
   clouds_.retain(keep);
   database_.retain(keep);
   renumber(accepted_, merged.new_index);

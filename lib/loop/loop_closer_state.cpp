@@ -154,9 +154,8 @@ bool LoopCloser::restoreState(const std::string& state, const std::vector<std::s
     restored.graph_.addNode(pose);
     restored.database_.add(*context, kf.utime);
     restored.keyframes_.push_back(std::move(kf));
-    restored.clouds_.add(std::move(*cloud));
-    restored.keypoints_.push_back(keypoints->empty() ? nullptr
-                                                     : std::make_shared<const KeyframeKeypoints>(std::move(*keypoints)));
+    restored.clouds_.add(std::move(*cloud), keypoints->empty() ? nullptr
+                                                               : std::make_shared<const KeyframeKeypoints>(std::move(*keypoints)));
   }
   const auto edges = r.getCount(4 + 4 + 96 + 288 + 1);
   for (std::uint64_t i = 0; i < edges && r.ok(); ++i) {

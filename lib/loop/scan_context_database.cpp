@@ -1,6 +1,8 @@
 #include "loop/scan_context_database.hpp"
 
+#include "core/byte_codec.hpp"
 #include "loop/keep_mask.hpp"
+#include "loop/keyframe_codec.hpp"
 
 #include <nanoflann.hpp>
 
@@ -38,33 +40,116 @@ ScanContextDatabase& ScanContextDatabase::operator=(ScanContextDatabase&&) noexc
 
 int ScanContextDatabase::add(const ScanContext& context, std::int64_t utime) {
   contexts_.push_back(context);
+  ring_keys_.push_back(context.ringKey());
+  offsets_.push_back(-1);
   utimes_.push_back(utime);
   if (size() - tree_size_ >= rebuild_every_) rebuildTree();
+  pageOut();
   return size() - 1;
 }
 
 void ScanContextDatabase::retain(const std::vector<bool>& keep) {
+  next_to_page_ = keptAmongFirst(keep, next_to_page_);
   eraseUnkept(contexts_, keep);
+  eraseUnkept(ring_keys_, keep);
+  eraseUnkept(offsets_, keep);
   eraseUnkept(utimes_, keep);
   contexts_.shrink_to_fit();
+  ring_keys_.shrink_to_fit();
+  offsets_.shrink_to_fit();
   utimes_.shrink_to_fit();
   tree_.reset();
   tree_size_ = 0;
   if (size() >= rebuild_every_) rebuildTree();
 }
 
+ScanContext ScanContextDatabase::context(int index) const {
+  ScanContext scratch;
+  const ScanContext& c = load(index, scratch);
+  return &c == &scratch ? std::move(scratch) : c;
+}
+
+const ScanContext& ScanContextDatabase::load(int index, ScanContext& scratch) const {
+  const auto i = static_cast<std::size_t>(index);
+  if (offsets_[i] < 0) return contexts_[i];
+  // A record: its size, then the context as a checkpoint writes it (keyframe_codec.hpp).
+  std::uint32_t bytes = 0;
+  std::string record;
+  if (file_.read(offsets_[i], &bytes, sizeof bytes)) {
+    record.resize(bytes);
+    if (file_.read(offsets_[i] + static_cast<std::int64_t>(sizeof bytes), record.data(), record.size())) {
+      ByteReader r(record);
+      if (std::optional<ScanContext> read = getScanContext(r); read && r.ok() && r.atEnd()) {
+        scratch = std::move(*read);
+        return scratch;
+      }
+    }
+  }
+  ++read_errors_;
+  scratch = ScanContext();
+  return scratch;
+}
+
+void ScanContextDatabase::pageTo(const std::string& path, std::size_t resident) {
+  PageFile file = PageFile::create(path, "Scan Context");
+  for (int i = 0; i < size(); ++i) {  // contexts paged to an earlier file come back first
+    if (offsets_[static_cast<std::size_t>(i)] < 0) continue;
+    contexts_[static_cast<std::size_t>(i)] = context(i);
+    offsets_[static_cast<std::size_t>(i)] = -1;
+  }
+  file_ = std::move(file);
+  resident_ = resident;
+  next_to_page_ = 0;
+  paged_ = 0;
+  pageOut();
+}
+
+void ScanContextDatabase::pageOut() {
+  if (!file_.isOpen()) return;
+  while (contexts_.size() - next_to_page_ > resident_) {
+    const std::size_t i = next_to_page_;
+    if (!contexts_[i].empty() && offsets_[i] < 0) {
+      ByteWriter w;
+      putScanContext(w, contexts_[i]);
+      const auto bytes = static_cast<std::uint32_t>(w.bytes().size());
+      std::string record(reinterpret_cast<const char*>(&bytes), sizeof bytes);
+      record += w.bytes();
+      const std::int64_t offset = file_.append(record.data(), record.size());
+      if (offset < 0) {
+        ++page_errors_;  // kept in memory; the next add tries again
+        return;
+      }
+      offsets_[i] = offset;
+      contexts_[i] = ScanContext();
+      ++paged_;
+    }
+    ++next_to_page_;
+  }
+}
+
+std::size_t ScanContextDatabase::residentBytes() const {
+  std::size_t bytes = contexts_.capacity() * sizeof(ScanContext) + ring_keys_.capacity() * sizeof(Eigen::VectorXf) +
+                      (offsets_.capacity() + utimes_.capacity()) * sizeof(std::int64_t);
+  for (std::size_t i = 0; i < contexts_.size(); ++i) {
+    const ScanContext& c = contexts_[i];
+    bytes += static_cast<std::size_t>(c.descriptor().size() + c.ringKey().size() + c.sectorKey().size()) * sizeof(float);
+    bytes += static_cast<std::size_t>(ring_keys_[i].size()) * sizeof(float);
+  }
+  return bytes;
+}
+
 void ScanContextDatabase::rebuildTree() {
   std::size_t dim = 0;  // of the first real context (a revisit keyframe's is empty)
-  for (const ScanContext& c : contexts_)
-    if (!c.empty()) {
-      dim = static_cast<std::size_t>(c.ringKey().size());
+  for (const Eigen::VectorXf& key : ring_keys_)
+    if (key.size() > 0) {
+      dim = static_cast<std::size_t>(key.size());
       break;
     }
   std::vector<float> keys;
-  keys.reserve(contexts_.size() * dim);
-  for (const ScanContext& c : contexts_) {
+  keys.reserve(ring_keys_.size() * dim);
+  for (const Eigen::VectorXf& key : ring_keys_) {
     for (std::size_t d = 0; d < dim; ++d)
-      keys.push_back(static_cast<std::size_t>(c.ringKey().size()) == dim ? c.ringKey()[static_cast<Eigen::Index>(d)] : 0.0f);
+      keys.push_back(static_cast<std::size_t>(key.size()) == dim ? key[static_cast<Eigen::Index>(d)] : 0.0f);
   }
   tree_ = std::make_unique<RingKeyTree>(std::move(keys), dim);
   tree_size_ = size();
@@ -97,15 +182,16 @@ std::vector<ScanContextCandidate> ScanContextDatabase::query(const ScanContext& 
   }
   const int linear_from = tree_ && tree_->dim == static_cast<std::size_t>(key.size()) ? tree_size_ : 0;
   for (int i = linear_from; i < eligible; ++i) {
-    const Eigen::VectorXf& other = contexts_[static_cast<std::size_t>(i)].ringKey();
+    const Eigen::VectorXf& other = ring_keys_[static_cast<std::size_t>(i)];
     if (other.size() != key.size()) continue;
     near.emplace_back((other - key).squaredNorm(), i);
   }
   std::sort(near.begin(), near.end());  // by distance, ties by index: deterministic
   if (static_cast<int>(near.size()) > num_candidates_) near.resize(static_cast<std::size_t>(num_candidates_));
 
+  ScanContext scratch;
   for (const auto& [sq, index] : near) {
-    const ScanContext& other = contexts_[static_cast<std::size_t>(index)];
+    const ScanContext& other = load(index, scratch);
     if (other.empty()) continue;
     ScanContextCandidate c;
     c.index = index;

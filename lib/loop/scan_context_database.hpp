@@ -1,7 +1,10 @@
 // Keyframe Scan Contexts and the place query: a KD-tree on the rotation-invariant ring keys proposes the
-// nearest keyframes, and the full column-shift distance ranks them.
+// nearest keyframes, and the full column-shift distance ranks them. A live process pages the descriptors of all
+// but the newest entries to a file (pageTo): only the ring keys stay in memory, and a candidate's descriptor is
+// read back to rank it, which gives the same context (ScanContext::fromDescriptor), so no result changes.
 #pragma once
 
+#include "loop/page_file.hpp"
 #include "loop/scan_context.hpp"
 
 #include <cstdint>
@@ -43,17 +46,36 @@ class ScanContextDatabase {
   void retain(const std::vector<bool>& keep);
 
   int size() const { return static_cast<int>(contexts_.size()); }
-  const ScanContext& context(int index) const { return contexts_[static_cast<std::size_t>(index)]; }
+  // Entry `index`'s context, from memory or the page file (an unreadable page gives an empty context, which
+  // never matches, counted in readErrors()).
+  ScanContext context(int index) const;
+
+  // Pages the descriptors of every entry but the newest `resident` out to `path`, now and as entries are added
+  // (see PageFile). Throws std::runtime_error if the file cannot be created; a failed write keeps the entry in
+  // memory and is counted (pageErrors()).
+  void pageTo(const std::string& path, std::size_t resident);
+  std::size_t residentBytes() const;  // contexts and ring keys in memory
+  std::size_t pagedContexts() const { return paged_; }
+  std::size_t pageErrors() const { return page_errors_; }
+  std::size_t readErrors() const { return read_errors_; }
 
  private:
   struct RingKeyTree;
   void rebuildTree();
+  void pageOut();
   int eligibleCount(int exclude_recent, std::int64_t latest_utime) const;
+  // The context of entry `index` (empty if it has none): in memory, or read into `scratch`.
+  const ScanContext& load(int index, ScanContext& scratch) const;
 
   int num_candidates_;
   int rebuild_every_;
-  std::vector<ScanContext> contexts_;
+  std::vector<ScanContext> contexts_;  // a paged entry's is empty: its ring key and offset say where it is
+  std::vector<Eigen::VectorXf> ring_keys_;  // of every entry, paged or not
+  std::vector<std::int64_t> offsets_;       // in the page file, or -1
   std::vector<std::int64_t> utimes_;
+  PageFile file_;
+  std::size_t resident_ = 0, next_to_page_ = 0, paged_ = 0, page_errors_ = 0;
+  mutable std::size_t read_errors_ = 0;
   std::unique_ptr<RingKeyTree> tree_;  // over the first tree_size_ entries
   int tree_size_ = 0;
 };

@@ -99,9 +99,9 @@ class LoopCloserNode : public runtime::Node, public WritesProducts, public Write
     // Paged after the resume: the checkpoint's keyframes come back into memory and the oldest go out again.
     if (node_.clouds_in_memory > 0) {
       try {
-        closer_.pageCloudsTo(folder.file("loop_closer.clouds"), static_cast<std::size_t>(node_.clouds_in_memory));
+        closer_.pageKeyframesTo(folder.file("loop_closer.clouds"), static_cast<std::size_t>(node_.clouds_in_memory));
       } catch (const std::exception& e) {
-        reportError("cloud_paging_failed", std::string(e.what()) + " (keyframe clouds stay in memory)");
+        reportError("cloud_paging_failed", std::string(e.what()) + " (keyframes stay in memory)");
       }
     }
   }
@@ -184,6 +184,11 @@ class LoopCloserNode : public runtime::Node, public WritesProducts, public Write
     setCount("clouds_paged", static_cast<std::int64_t>(clouds.pagedClouds()));
     setCount("cloud_page_errors", static_cast<std::int64_t>(clouds.pageErrors()));
     setCount("cloud_read_errors", static_cast<std::int64_t>(clouds.readErrors()));
+    const ScanContextDatabase& contexts = closer_.contexts();
+    setCount("scan_context_memory_kb", static_cast<std::int64_t>(contexts.residentBytes() / 1024));
+    setCount("scan_contexts_paged", static_cast<std::int64_t>(contexts.pagedContexts()));
+    setCount("scan_context_page_errors", static_cast<std::int64_t>(contexts.pageErrors()));
+    setCount("scan_context_read_errors", static_cast<std::int64_t>(contexts.readErrors()));
     setCount("trajectory_poses_in_memory", static_cast<std::int64_t>(trajectory_.inMemory()));
   }
 

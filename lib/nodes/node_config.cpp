@@ -90,7 +90,7 @@ const ConfigTable<LoopCloserNodeConfig>& loopCloserNodeConfigTable() {
     ConfigTable<N> t("loop");
     t.add("map_voxel", &N::map_voxel, atLeast(0), "m", "voxel of the loop-corrected map.pcd (0 = no downsampling)")
      .add("node.checkpoint_keyframes", &N::checkpoint_keyframes, atLeast(0), "", "keyframes between loop-closer checkpoints in live runs (0 = never)")
-     .add("node.clouds_in_memory", &N::clouds_in_memory, atLeast(0), "keyframes", "keyframe clouds kept in memory in live runs, older ones paged to a file in the run folder (0 = all in memory)");
+     .add("node.clouds_in_memory", &N::clouds_in_memory, atLeast(0), "keyframes", "keyframes whose clouds, keypoints and Scan Contexts stay in memory in live runs, older ones paged to files in the run folder (0 = all in memory)");
     return t;
   }();
   return table;

@@ -44,8 +44,9 @@ struct MapperNodeConfig {
 struct LoopCloserNodeConfig {
   double map_voxel = 0.1;         // key "loop.map_voxel" (kept where it always was)
   int checkpoint_keyframes = 10;  // key "loop.node.checkpoint_keyframes": keyframes between checkpoints (0 = never)
-  // key "loop.node.clouds_in_memory": in a live run (a run folder), the newest keyframe clouds kept in memory;
-  // older ones go to a page file there (loop/keyframe_cloud_store.hpp). 0 keeps every cloud in memory.
+  // key "loop.node.clouds_in_memory": in a live run (a run folder), the newest keyframes whose clouds, keypoints
+  // and Scan Contexts stay in memory; older ones go to page files there (loop/keyframe_cloud_store.hpp,
+  // loop/scan_context_database.hpp). 0 keeps everything in memory.
   int clouds_in_memory = 100;
 };
 

@@ -127,6 +127,37 @@ TEST(KeyframeCloudStore, PagedCloudsReadBackAsWritten) {
   EXPECT_LT(moved.residentBytes(), 4096u) << "one cloud and the per-keyframe slots";
 }
 
+TEST(KeyframeCloudStore, KeypointsArePagedWithTheirCloud) {
+  const auto keypointsOf = [](int k) {
+    std::vector<Eigen::Vector3f> points;
+    std::vector<adit::LinK3dDescriptor> descriptors;
+    for (int i = 0; i < 3 + k % 4; ++i) {
+      points.emplace_back(static_cast<float>(k), static_cast<float>(i), 0.5f);
+      adit::LinK3dDescriptor d{};
+      d[static_cast<std::size_t>((k + i) % d.size())] = 1.25f + 0.01f * static_cast<float>(i);
+      descriptors.push_back(d);
+    }
+    return std::make_shared<const adit::KeyframeKeypoints>(adit::KeyframeKeypoints::encode(points, descriptors));
+  };
+  adit::KeyframeCloudStore store;
+  store.pageTo(::testing::TempDir() + "store_keypoints.clouds", 2);
+  for (int k = 0; k < 8; ++k) store.add(cloudOf(k), k == 5 ? nullptr : keypointsOf(k));
+  store.drop(3);
+  EXPECT_EQ(store.pagedClouds(), 6u);  // 0-5 (3 dropped after it went out)
+  for (int k = 0; k < 8; ++k) {
+    const adit::KeyframeKeypointsPtr p = store.keypoints(k);
+    if (k == 3 || k == 5) {
+      EXPECT_EQ(p, nullptr) << k;
+      continue;
+    }
+    ASSERT_NE(p, nullptr) << k;
+    EXPECT_EQ(p->points(), keypointsOf(k)->points()) << k;
+    EXPECT_EQ(p->descriptors(), keypointsOf(k)->descriptors()) << k;
+    EXPECT_EQ(store.cloud(k).counts(), cloudOf(k).counts()) << k;
+  }
+  EXPECT_EQ(store.readErrors(), 0u);
+}
+
 TEST(KeyframeCloudStore, AFailedPageWriteKeepsTheCloudInMemory) {
   // A file size limit makes every write to the page file fail (EFBIG), as a full disk would.
   std::signal(SIGXFSZ, SIG_IGN);

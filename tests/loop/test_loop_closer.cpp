@@ -241,7 +241,7 @@ TEST(LoopCloser, RevisitedKeyframesKeepOnlyTheirGraphNode) {
 
   // Clouds paged to a file (a live process) give the same graph, records and map, from a fraction of the memory.
   Drive paged{LoopCloser{testConfig()}, 0, {}};
-  paged.closer.pageCloudsTo(::testing::TempDir() + "loop_closer_test.clouds", 10);
+  paged.closer.pageKeyframesTo(::testing::TempDir() + "loop_closer_test.clouds", 10);
   drive(paged, world, truth, mapped);
   const KeyframeCloudStore& store = paged.closer.clouds();
   std::printf("paged: %zu clouds in the page file (%llu bytes), %zu kB in memory vs %zu kB unpaged\n",
@@ -255,6 +255,15 @@ TEST(LoopCloser, RevisitedKeyframesKeepOnlyTheirGraphNode) {
   EXPECT_LT(store.residentBytes(), thin.closer.clouds().residentBytes() / 5);
   EXPECT_EQ(store.readErrors(), 0u);
   EXPECT_EQ(store.pageErrors(), 0u);
+  // Their Scan Contexts too: only the ring keys stay, and a candidate's descriptor read back ranks the same.
+  const ScanContextDatabase& contexts = paged.closer.contexts();
+  std::printf("paged: %zu Scan Contexts in their page file, %zu kB in memory vs %zu kB unpaged\n",
+              contexts.pagedContexts(), contexts.residentBytes() / 1024, thin.closer.contexts().residentBytes() / 1024);
+  EXPECT_GE(contexts.pagedContexts(), 100u);
+  EXPECT_LT(contexts.residentBytes(), thin.closer.contexts().residentBytes() / 3);
+  EXPECT_EQ(contexts.readErrors(), 0u);
+  EXPECT_EQ(contexts.pageErrors(), 0u);
+  EXPECT_EQ(paged.closer.stats().accepted, thin.closer.stats().accepted);
 }
 
 // A patrol: the block driven three times. Once the second lap revisits the first, its keyframes keep only a

@@ -111,3 +111,44 @@ TEST(ScanContextDatabase, FindsTheRightPlaceAmongDistractors) {
   for (const auto& c : db.query(query, 0, target * 1000000LL - 1)) EXPECT_LT(c.index, target);
   EXPECT_TRUE(db.query(query, places).empty());
 }
+
+// Paged (a live process): only the ring keys and the newest contexts stay in memory, and every query, every
+// context and the database's state after merging entries out are what they are unpaged.
+TEST(ScanContextDatabase, PagedContextsGiveTheSameCandidates) {
+  const ScanContextConfig config;
+  ScanContextDatabase all(10, 50), paged(10, 50);
+  paged.pageTo(::testing::TempDir() + "scan_context_test.sc", 5);
+  std::vector<ScanContext> queries;
+  for (int i = 0; i < 90; ++i) {
+    const auto world = makeRoadway(300 + static_cast<std::uint32_t>(i % 30), 4.5 + 0.005 * (i % 30), 12, i % 3 == 0);
+    const ScanContext c = i % 7 == 3 ? ScanContext()  // a revisit keyframe's empty context
+                                     : ScanContext::build(sweepAt(world, 0.05 * (i / 30), 0.0, 0.3 * i, 7 + i), config);
+    all.add(c, i * 1000000LL);
+    paged.add(c, i * 1000000LL);
+    if (i % 10 == 0) queries.push_back(c);
+  }
+  EXPECT_EQ(paged.pagedContexts(), 85u - 12u);  // of the 85 oldest, those not empty
+  EXPECT_LT(paged.residentBytes(), all.residentBytes() / 5);
+  const auto same = [&](const char* when) {
+    for (int i = 0; i < all.size(); ++i)
+      EXPECT_EQ(paged.context(i).descriptor(), all.context(i).descriptor()) << when << " entry " << i;
+    for (const ScanContext& q : queries) {
+      const auto a = all.query(q, 3), b = paged.query(q, 3);
+      ASSERT_EQ(a.size(), b.size()) << when;
+      for (std::size_t j = 0; j < a.size(); ++j) {
+        EXPECT_EQ(a[j].index, b[j].index) << when;
+        EXPECT_EQ(a[j].distance, b[j].distance) << when;
+        EXPECT_EQ(a[j].shift, b[j].shift) << when;
+      }
+    }
+  };
+  same("paged");
+  std::vector<bool> keep(90, true);
+  for (int i = 10; i < 40; i += 2) keep[static_cast<std::size_t>(i)] = false;
+  all.retain(keep);
+  paged.retain(keep);
+  same("after merging");
+  EXPECT_EQ(paged.readErrors(), 0u);
+  EXPECT_THROW(paged.pageTo("/nonexistent-folder/x.sc", 1), std::runtime_error);
+  same("after a failed re-page");
+}
