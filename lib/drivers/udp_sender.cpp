@@ -41,7 +41,8 @@ void parseUdpAddress(const std::string& text, std::string& host, std::uint16_t& 
   const auto bad = [&](const std::string& why) {
     return std::invalid_argument("'" + text + "' is not HOST:PORT (" + why + ")");
   };
-  if (colon == std::string::npos || colon == 0) throw bad("no host");
+  if (colon == std::string::npos) throw bad("no port");
+  if (colon == 0) throw bad("no host");
   const std::string digits = text.substr(colon + 1);
   if (digits.empty() || digits.size() > 5 || digits.find_first_not_of("0123456789") != std::string::npos)
     throw bad("the port is not a number");
