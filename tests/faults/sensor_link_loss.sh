@@ -55,10 +55,11 @@ expect "IMU messages dropped" "$imu_dropped" ">" 0
 lost_packets=$(fact "$WORK/lossy.facts" counter STATUS_LIDAR_BRIDGE lost_packets)
 late=$(fact "$WORK/lossy.facts" counter STATUS_LIDAR_BRIDGE time_backwards)
 # The bridge sees the holes in the stamps: every dropped packet and every one overtaken (skipped as late), less
-# those in holes long enough to count as packet_gap, and the few of the run's first and last moments.
+# those in holes long enough to count as packet_gap, and the few of the run's first and last moments. (More is
+# possible on a loaded machine: packets the bridge's socket buffer dropped. The count's exactness is the
+# drivers unit test's.)
 expect "lost packets counted by the lidar bridge (dropped $lidar_dropped + late $late)" "$lost_packets" ">=" \
   "$(( (lidar_dropped + late) * 9 / 10 ))"
-expect "lost packets counted by the lidar bridge, at most" "$lost_packets" "<=" "$((lidar_dropped + late))"
 imu_lost=$(fact "$WORK/lossy.facts" counter STATUS_FEATURE lost_input)
 expect "lost inputs counted by the feature stage" "$imu_lost" ">" 0
 expect "sweeps published by the lidar bridge (clean: $(fact "$WORK/clean.facts" outputs STATUS_LIDAR_BRIDGE))" \
