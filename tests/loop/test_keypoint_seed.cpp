@@ -264,6 +264,14 @@ TEST(KeypointSeed, KeyframeKeypointsSurviveACheckpointAndOlderRecordsStillLoad) 
     EXPECT_EQ(restored.keyframeKeypoints(k).points(), closer.keyframeKeypoints(k).points()) << k;
     EXPECT_EQ(restored.keyframeKeypoints(k).descriptors(), closer.keyframeKeypoints(k).descriptors()) << k;
   }
+  // Paged with their clouds (a live process), they read back the same, and so do the records.
+  restored.pageKeyframesTo(::testing::TempDir() + "keypoint_seed_test.clouds", 1);
+  EXPECT_EQ(restored.clouds().pagedClouds(), 3u);
+  for (int k = 0; k < 4; ++k) {
+    EXPECT_EQ(restored.keyframeKeypoints(k).points(), closer.keyframeKeypoints(k).points()) << k;
+    EXPECT_EQ(restored.keyframeKeypoints(k).descriptors(), closer.keyframeKeypoints(k).descriptors()) << k;
+    EXPECT_EQ(restored.keyframeRecord(k), records[static_cast<std::size_t>(k)]) << k;
+  }
 
   // A record written before keyframes kept keypoints ends after the step covariance: it loads, without them.
   std::vector<std::string> older = records;
