@@ -75,7 +75,8 @@ const ScanContext& ScanContextDatabase::load(int index, ScanContext& scratch) co
   // A record: its size, then the context as a checkpoint writes it (keyframe_codec.hpp).
   std::uint32_t bytes = 0;
   std::string record;
-  if (file_.read(offsets_[i], &bytes, sizeof bytes)) {
+  constexpr std::uint32_t kMaxRecord = 1u << 24;  // a 1000 x 1000 context (the codec's limit) is 4 MB
+  if (file_.read(offsets_[i], &bytes, sizeof bytes) && bytes <= kMaxRecord) {
     record.resize(bytes);
     if (file_.read(offsets_[i] + static_cast<std::int64_t>(sizeof bytes), record.data(), record.size())) {
       ByteReader r(record);
