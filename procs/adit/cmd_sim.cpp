@@ -14,6 +14,8 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include <cmath>
+
 namespace {
 
 struct SimArgs {
@@ -95,9 +97,9 @@ void registerSimCommand(CLI::App& app) {
   cmd->add_option("--rate", a->rate, "With --live: multiple of real time (0 = as fast as possible)")->check(CLI::NonNegativeNumber);
   cmd->add_option("--lcm-url", a->lcm_url, "With --live: LCM provider (default: $LCM_DEFAULT_URL or udpm)");
   cmd->add_option("--lidar-udp", a->lidar_udp,
-                  "With --live (vlp16, rate 1): send the lidar as VLP-16 UDP packets to HOST:PORT instead of "
-                  "LIDAR_POINTS, for adit-lidar-bridge (launch/sim-packets.launch.yaml); the clock starts at the "
-                  "wall clock, as the packets' stamps are UTC");
+                  "With --live (vlp16): send the lidar as VLP-16 UDP packets to HOST:PORT instead of LIDAR_POINTS, "
+                  "for adit-lidar-bridge (launch/sim-packets.launch.yaml); the clock starts at the wall clock, as "
+                  "the packets' stamps are UTC (so the run must stay within half an hour of it)");
   cmd->add_flag("--no-ground-truth-channel", a->no_truth_channel, "Do not publish GROUND_TRUTH");
   cmd->add_option("--start-speed", a->start_speed,
                   "Already driving at this speed (m/s) at time 0, as a log cut from a drive (sim.motion.start_speed; "
@@ -122,8 +124,8 @@ void registerSimCommand(CLI::App& app) {
     std::string udp_host;
     std::uint16_t udp_port = 0;
     if (!a->lidar_udp.empty()) {
-      if (!a->live || a->rate != 1.0)
-        throw CLI::ValidationError("--lidar-udp", "needs --live at --rate 1 (the packets' stamps are UTC)");
+      if (!a->live || !(a->rate > 0))
+        throw CLI::ValidationError("--lidar-udp", "needs --live at a --rate above 0 (the packets' stamps are UTC)");
       try {
         adit::drivers::parseUdpAddress(a->lidar_udp, udp_host, udp_port);
       } catch (const std::invalid_argument& e) {
@@ -143,8 +145,16 @@ void registerSimCommand(CLI::App& app) {
     if (a->start_distance >= 0) config.motion.start_distance = a->start_distance;
     if (a->reverse) config.motion.reverse = true;
     if (a->stationary) config.motion.stationary = true;
-    // A sensor's packets carry UTC stamps: the simulated clock is the host's, to the millisecond.
-    if (!a->lidar_udp.empty()) config.start_utime = adit::runtime::wallUtime() / 1000 * 1000;
+    // A sensor's packets carry UTC stamps: the simulated clock is the host's, to the millisecond. A VLP-16 stamp
+    // is microseconds past the hour, which the bridge takes from its own clock: away from real time the two
+    // clocks part (the bridge counts clock_not_utc), and beyond half an hour it would read the wrong hour.
+    if (!a->lidar_udp.empty()) {
+      if (config.duration_s * std::abs(1.0 - 1.0 / a->rate) >= 1800.0)
+        throw CLI::ValidationError("--lidar-udp", "at --rate " + fmt::format("{:g}", a->rate) + " the simulated clock of a " +
+                                                      fmt::format("{:g}", config.duration_s) +
+                                                      " s run leaves the wall clock by half an hour or more");
+      config.start_utime = adit::runtime::wallUtime() / 1000 * 1000;
+    }
 
     adit::sources::SimChannels channels;
     if (a->no_truth_channel) channels.ground_truth.clear();
