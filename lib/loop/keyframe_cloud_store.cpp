@@ -33,7 +33,7 @@ void KeyframeCloudStore::drop(int k) {
 void KeyframeCloudStore::retain(const std::vector<bool>& keep) {
   for (std::size_t k = 0; k < slots_.size() && k < keep.size(); ++k)
     if (!keep[k]) resident_bytes_ -= bytesOf(slots_[k]);
-  next_to_page_ = keptAmongFirst(keep, next_to_page_);
+  queue_.retain(keep);
   eraseUnkept(slots_, keep);
   slots_.shrink_to_fit();
 }
@@ -81,36 +81,30 @@ void KeyframeCloudStore::pageTo(const std::string& path, std::size_t resident) {
     resident_bytes_ += bytesOf(slot);
   }
   file_ = std::move(file);
-  resident_ = resident;
-  next_to_page_ = 0;
-  paged_ = 0;
+  queue_.restart(resident);
   pageOut();
 }
 
 void KeyframeCloudStore::pageOut() {
-  if (!file_.isOpen()) return;
-  while (slots_.size() - next_to_page_ > resident_) {
-    Slot& slot = slots_[next_to_page_];
-    if (slot.points > 0 && slot.offset < 0) {
-      const std::vector<std::int16_t>& counts = slot.cloud.counts();
-      ByteWriter keypoints;
-      if (slot.keypoints) slot.keypoints->put(keypoints);
-      std::string record(reinterpret_cast<const char*>(counts.data()), counts.size() * sizeof(std::int16_t));
-      record += keypoints.bytes();
-      const std::int64_t offset = file_.append(record.data(), record.size());
-      if (offset < 0) {
-        ++page_errors_;  // kept in memory; the next add tries again
-        return;
-      }
-      resident_bytes_ -= bytesOf(slot);
-      slot.offset = offset;
-      slot.keypoint_bytes = static_cast<std::uint32_t>(keypoints.bytes().size());
-      slot.cloud = CompactCloud();
-      slot.keypoints.reset();
-      ++paged_;
-    }
-    ++next_to_page_;
-  }
+  if (file_.isOpen()) queue_.pageOut(slots_.size(), [this](std::size_t k) { return pageOne(slots_[k]); });
+}
+
+// One record: the cloud's counts, then its keypoints.
+PagingQueue::Outcome KeyframeCloudStore::pageOne(Slot& slot) {
+  if (slot.points == 0 || slot.offset >= 0) return PagingQueue::Outcome::kNothingToPage;
+  const std::vector<std::int16_t>& counts = slot.cloud.counts();
+  ByteWriter keypoints;
+  if (slot.keypoints) slot.keypoints->put(keypoints);
+  std::string record(reinterpret_cast<const char*>(counts.data()), counts.size() * sizeof(std::int16_t));
+  record += keypoints.bytes();
+  const std::int64_t offset = file_.append(record.data(), record.size());
+  if (offset < 0) return PagingQueue::Outcome::kFailed;  // kept in memory; the next add tries again
+  resident_bytes_ -= bytesOf(slot);
+  slot.offset = offset;
+  slot.keypoint_bytes = static_cast<std::uint32_t>(keypoints.bytes().size());
+  slot.cloud = CompactCloud();
+  slot.keypoints.reset();
+  return PagingQueue::Outcome::kPaged;
 }
 
 std::size_t KeyframeCloudStore::residentBytes() const { return slots_.capacity() * sizeof(Slot) + resident_bytes_; }

@@ -37,9 +37,9 @@ class KeyframeCloudStore {
   void pageTo(const std::string& path, std::size_t resident);
 
   std::size_t residentBytes() const;  // the clouds and keypoints in memory and the per-keyframe slots
-  std::size_t pagedClouds() const { return paged_; }
+  std::size_t pagedClouds() const { return queue_.paged(); }
   std::uint64_t pageFileBytes() const { return file_.size(); }
-  std::size_t pageErrors() const { return page_errors_; }
+  std::size_t pageErrors() const { return queue_.errors(); }
   std::size_t readErrors() const { return read_errors_; }
 
  private:
@@ -53,14 +53,12 @@ class KeyframeCloudStore {
   };
   static std::size_t bytesOf(const Slot& slot);
   void pageOut();
+  PagingQueue::Outcome pageOne(Slot& slot);
 
   std::vector<Slot> slots_;
   PageFile file_;
-  std::size_t resident_ = 0;
+  PagingQueue queue_;
   std::size_t resident_bytes_ = 0;  // of the clouds and keypoints in memory
-  std::size_t next_to_page_ = 0;  // slots before it are paged out (or empty)
-  std::size_t paged_ = 0;
-  std::size_t page_errors_ = 0;
   mutable std::size_t read_errors_ = 0;
 };
 

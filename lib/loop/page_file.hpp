@@ -3,9 +3,12 @@
 // process is; a restart reads its keyframes from the checkpoint instead. Not thread-safe.
 #pragma once
 
+#include "loop/keep_mask.hpp"
+
 #include <cstddef>
 #include <cstdint>
 #include <string>
+#include <vector>
 
 namespace adit {
 
@@ -31,6 +34,45 @@ class PageFile {
  private:
   int fd_ = -1;
   std::int64_t end_ = 0;
+};
+
+// Which entries of a growing list go to a page file: all but the newest `resident`, oldest first, each once. What
+// the stores that page (keyframe clouds, Scan Contexts) share; how an entry is written is theirs.
+class PagingQueue {
+ public:
+  enum class Outcome { kNothingToPage, kPaged, kFailed };
+
+  // From the first entry again, keeping `resident` in memory (a new page file).
+  void restart(std::size_t resident) {
+    resident_ = resident;
+    next_ = 0;
+    paged_ = 0;
+  }
+  // Offers the entries due, oldest first, to page(i) -> Outcome. A failed write stops here and leaves entry i
+  // first in line for the next call (counted in errors(): the entry stays in memory).
+  template <class PageOne>
+  void pageOut(std::size_t size, PageOne page) {
+    while (size - next_ > resident_) {
+      const Outcome outcome = page(next_);
+      if (outcome == Outcome::kFailed) {
+        ++errors_;
+        return;
+      }
+      if (outcome == Outcome::kPaged) ++paged_;
+      ++next_;
+    }
+  }
+  // The entries with keep[i] false left the list (keyframes merged out): the line keeps its place.
+  void retain(const std::vector<bool>& keep) { next_ = keptAmongFirst(keep, next_); }
+
+  std::size_t paged() const { return paged_; }
+  std::size_t errors() const { return errors_; }
+
+ private:
+  std::size_t resident_ = 0;
+  std::size_t next_ = 0;  // entries before it are paged out (or had nothing to page)
+  std::size_t paged_ = 0;
+  std::size_t errors_ = 0;
 };
 
 }  // namespace adit

@@ -49,7 +49,7 @@ int ScanContextDatabase::add(const ScanContext& context, std::int64_t utime) {
 }
 
 void ScanContextDatabase::retain(const std::vector<bool>& keep) {
-  next_to_page_ = keptAmongFirst(keep, next_to_page_);
+  queue_.retain(keep);
   eraseUnkept(contexts_, keep);
   eraseUnkept(ring_keys_, keep);
   eraseUnkept(offsets_, keep);
@@ -99,33 +99,27 @@ void ScanContextDatabase::pageTo(const std::string& path, std::size_t resident) 
     offsets_[static_cast<std::size_t>(i)] = -1;
   }
   file_ = std::move(file);
-  resident_ = resident;
-  next_to_page_ = 0;
-  paged_ = 0;
+  queue_.restart(resident);
   pageOut();
 }
 
 void ScanContextDatabase::pageOut() {
-  if (!file_.isOpen()) return;
-  while (contexts_.size() - next_to_page_ > resident_) {
-    const std::size_t i = next_to_page_;
-    if (!contexts_[i].empty() && offsets_[i] < 0) {
-      ByteWriter w;
-      putScanContext(w, contexts_[i]);
-      const auto bytes = static_cast<std::uint32_t>(w.bytes().size());
-      std::string record(reinterpret_cast<const char*>(&bytes), sizeof bytes);
-      record += w.bytes();
-      const std::int64_t offset = file_.append(record.data(), record.size());
-      if (offset < 0) {
-        ++page_errors_;  // kept in memory; the next add tries again
-        return;
-      }
-      offsets_[i] = offset;
-      contexts_[i] = ScanContext();
-      ++paged_;
-    }
-    ++next_to_page_;
-  }
+  if (file_.isOpen()) queue_.pageOut(contexts_.size(), [this](std::size_t i) { return pageOne(i); });
+}
+
+// One record: its size, then the context as a checkpoint writes it.
+PagingQueue::Outcome ScanContextDatabase::pageOne(std::size_t i) {
+  if (contexts_[i].empty() || offsets_[i] >= 0) return PagingQueue::Outcome::kNothingToPage;
+  ByteWriter w;
+  putScanContext(w, contexts_[i]);
+  const auto bytes = static_cast<std::uint32_t>(w.bytes().size());
+  std::string record(reinterpret_cast<const char*>(&bytes), sizeof bytes);
+  record += w.bytes();
+  const std::int64_t offset = file_.append(record.data(), record.size());
+  if (offset < 0) return PagingQueue::Outcome::kFailed;  // kept in memory; the next add tries again
+  offsets_[i] = offset;
+  contexts_[i] = ScanContext();
+  return PagingQueue::Outcome::kPaged;
 }
 
 std::size_t ScanContextDatabase::residentBytes() const {

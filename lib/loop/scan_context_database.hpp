@@ -55,14 +55,15 @@ class ScanContextDatabase {
   // memory and is counted (pageErrors()).
   void pageTo(const std::string& path, std::size_t resident);
   std::size_t residentBytes() const;  // contexts and ring keys in memory
-  std::size_t pagedContexts() const { return paged_; }
-  std::size_t pageErrors() const { return page_errors_; }
+  std::size_t pagedContexts() const { return queue_.paged(); }
+  std::size_t pageErrors() const { return queue_.errors(); }
   std::size_t readErrors() const { return read_errors_; }
 
  private:
   struct RingKeyTree;
   void rebuildTree();
   void pageOut();
+  PagingQueue::Outcome pageOne(std::size_t index);
   int eligibleCount(int exclude_recent, std::int64_t latest_utime) const;
   // The context of entry `index` (empty if it has none): in memory, or read into `scratch`.
   const ScanContext& load(int index, ScanContext& scratch) const;
@@ -74,7 +75,7 @@ class ScanContextDatabase {
   std::vector<std::int64_t> offsets_;       // in the page file, or -1
   std::vector<std::int64_t> utimes_;
   PageFile file_;
-  std::size_t resident_ = 0, next_to_page_ = 0, paged_ = 0, page_errors_ = 0;
+  PagingQueue queue_;
   mutable std::size_t read_errors_ = 0;
   std::unique_ptr<RingKeyTree> tree_;  // over the first tree_size_ entries
   int tree_size_ = 0;
