@@ -3,10 +3,10 @@
 // due time, instead of publishing LIDAR_POINTS on LCM; adit-lidar-bridge decodes them as it would a sensor's.
 // That is the path a real sensor's data takes, and the link of a robot that can lose packets (a cable, a
 // switch): the stages' own bus stays on the computer (ttl=0). The other channels (IMU, GROUND_TRUTH, ...)
-// are published as before.
+// are published as before. Give the SimSource SimChannels::sweep_bytes = false: the sweeps need not be encoded.
 // Time: the packets carry the sweep's own stamps (microseconds past the hour), so the bridge reads them with
 // lidar_driver.time_source utc and the simulator's clock must be the host's (cmd_sim starts it at the wall
-// clock and runs at real time).
+// clock and keeps the run within half an hour of it).
 #pragma once
 
 #include "drivers/udp_sender.hpp"

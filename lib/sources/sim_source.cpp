@@ -63,10 +63,10 @@ bool SimSource::next(runtime::OutgoingMessage& out) {
   }
   if (event.kind == sim::SimEvent::Kind::Scan) {
     for (const auto& observe : sweep_observers_) observe(event.scan);
-    out = {channels_.lidar,
-           channels_.compact_sweeps ? msg::encode(msg::encodeSweep(event.scan, &firing_table_))
-                                    : msg::encode(msg::toMessage(event.scan)),
-           event.scan.utime};
+    out = {channels_.lidar, {}, event.scan.utime};
+    if (channels_.sweep_bytes)
+      out.data = channels_.compact_sweeps ? msg::encode(msg::encodeSweep(event.scan, &firing_table_))
+                                          : msg::encode(msg::toMessage(event.scan));
     truth_.push_back(event.truth);
     if (!channels_.ground_truth.empty()) {
       PoseEstimate truth;

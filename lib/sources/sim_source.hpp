@@ -20,6 +20,9 @@ struct SimChannels {
   std::string wheel_odom = "WHEEL_ODOM";      // published when the simulation has wheel odometry (sim.wheel.enabled)
   // false: sweeps as full-float point_cloud_t, the format of logs before lidar_scan_t (tests of old logs).
   bool compact_sweeps = true;
+  // false: a sweep's message carries no bytes, only its channel and time, for a wrapper that sends the sweep
+  // another way (SimLidarUdpSource: as the sensor's UDP packets); encoding it would be wasted.
+  bool sweep_bytes = true;
 };
 
 // Sensor outages for fault tests: a stream publishes nothing from start_s (seconds of sensor time after the

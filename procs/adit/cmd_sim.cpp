@@ -159,6 +159,7 @@ void registerSimCommand(CLI::App& app) {
     adit::sources::SimChannels channels;
     if (a->no_truth_channel) channels.ground_truth.clear();
     if (a->no_imu) channels.imu.clear();
+    channels.sweep_bytes = a->lidar_udp.empty();  // --lidar-udp: the sweeps leave as packets
     const adit::sources::SimStalls stalls{parseStall(a->stall_lidar, "--stall-lidar"),
                                           parseStall(a->stall_imu, "--stall-imu")};
     adit::sources::SimSource source(config, channels, stalls);

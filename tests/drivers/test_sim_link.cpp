@@ -36,7 +36,9 @@ LinkRun runLink(const std::function<bool(std::int64_t)>& drop) {
   config.sensor = "vlp16";
   config.duration_s = 1.0;
   config.start_utime = runtime::wallUtime() / 1000 * 1000;  // the packets' stamps are UTC, as cmd_sim does
-  SimSource sim(config, SimChannels{});
+  SimChannels channels;
+  channels.sweep_bytes = false;
+  SimSource sim(config, channels);
   drivers::UdpReceiver receiver("127.0.0.1", 0, 8 * 1024 * 1024);
   LinkRun run;
   sim.addSweepObserver([&run](const LidarScan& scan) { run.sim_returns[scan.utime] = scan.points.size(); });
