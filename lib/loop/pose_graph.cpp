@@ -9,6 +9,10 @@
 #include <algorithm>
 #include <memory>
 
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
 namespace adit {
 namespace {
 
@@ -47,6 +51,19 @@ struct NodeState {
   Eigen::Vector3d p;
   Eigen::Quaterniond q;
 };
+
+// Ceres' num_threads does not reach the sparse Cholesky below it: CHOLMOD (SuiteSparse) opens OpenMP parallel
+// regions of its own fixed team size (4) once a supernodal factorisation is large enough, and OpenMP keeps
+// those threads for the life of the process (a two-hour live soak: the loop closer went 4 -> 7 threads at
+// 1 h 48 min; a 1,000-node lattice does it in a test), busy-waiting after each region. A team size clause overrides
+// omp_set_num_threads, so parallel regions are made inactive instead (zero active levels: a region runs on
+// the thread that opens it). The setting belongs to the calling thread, so it is made here, on whichever
+// thread solves.
+void solveOnThisThreadOnly() {
+#ifdef _OPENMP
+  omp_set_max_active_levels(0);
+#endif
+}
 
 }  // namespace
 
@@ -117,6 +134,7 @@ PoseGraphReport PoseGraph::optimize(const PoseGraphConfig& config) {
   options.max_num_iterations = config.max_iterations;
   options.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
   options.num_threads = 1;  // deterministic
+  solveOnThisThreadOnly();
   // A pose graph warm-started from odometry is well posed: start close to Gauss-Newton (fewer iterations).
   options.initial_trust_region_radius = 1e8;
   options.logging_type = ceres::SILENT;
