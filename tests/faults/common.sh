@@ -66,6 +66,32 @@ expect_grep() {
   if grep -qE "$2" "$3"; then echo "ok: $1"; else echo "FAIL: $1 (no line matching '$2' in $(basename "$3"))"; failed=1; fi
 }
 
+# start_reorder PERCENT IPTABLES_MATCH...: PERCENT % of the incoming datagrams that match are overtaken by 1-4
+# later ones (reorder-queue behind an iptables NFQUEUE rule). REORDER_STATE is on, or none (and said so) where
+# there is no reorder-queue, iptables or NFQUEUE target.
+start_reorder() {
+  local percent=$1; shift
+  REORDER_STATE=none REORDER_MATCH=("$@")
+  if [ "$percent" != 0 ] && [ -x "$BIN/reorder-queue" ] && command -v iptables > /dev/null &&
+     iptables -A INPUT "$@" -j NFQUEUE --queue-num 7 --queue-bypass 2>/dev/null; then
+    "$BIN/reorder-queue" --queue 7 --percent "$percent" --max-delay "${MAX_DELAY:-4}" > "$WORK/reorder.out" 2>&1 &
+    REORDER_PID=$!
+    trap 'kill -INT "$REORDER_PID" 2>/dev/null || true; cleanup' EXIT
+    REORDER_STATE=on
+  else
+    echo "reordering left out (needs reorder-queue, iptables and the NFQUEUE target)"
+  fi
+}
+
+# stop_reorder WHAT: removes the rule, ends reorder-queue, prints its report and checks that WHAT were overtaken.
+stop_reorder() {
+  [ "${REORDER_STATE:-none}" = on ] || return 0
+  iptables -D INPUT "${REORDER_MATCH[@]}" -j NFQUEUE --queue-num 7 --queue-bypass
+  kill -INT "$REORDER_PID"; wait "$REORDER_PID" || true
+  cat "$WORK/reorder.out"
+  expect "$1 held back and overtaken" "$(awk '/overtaken/ { print $4 }' "$WORK/reorder.out")" ">" 0
+}
+
 # The run folder a launch made under $WORK/logs (or $1).
 run_dir() { ls -d "${1:-$WORK/logs}"/*-*/ | head -1; }
 

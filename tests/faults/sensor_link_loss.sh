@@ -28,22 +28,9 @@ nft add rule ip lossy pre udp dport $PORT numgen random mod 100000 "<" "$thresho
 nft add rule ip lossy pre udp dport $PORT counter
 nft add rule ip lossy pre ip daddr 224.0.0.0/4 @th,128,32 0x494d5500 numgen random mod 100000 "<" "$threshold" counter drop
 nft add rule ip lossy pre ip daddr 224.0.0.0/4 @th,128,32 0x494d5500 counter
-reorder=none
-if [ "$REORDER" != 0 ] && [ -x "$BIN/reorder-queue" ] && command -v iptables > /dev/null &&
-   iptables -A INPUT -p udp --dport $PORT -j NFQUEUE --queue-num 7 --queue-bypass 2>/dev/null; then
-  "$BIN/reorder-queue" --queue 7 --percent "$REORDER" --max-delay 4 > "$WORK/reorder.out" 2>&1 &
-  REORDER_PID=$!
-  trap 'kill -INT "$REORDER_PID" 2>/dev/null || true; cleanup' EXIT
-  reorder=on
-else
-  echo "reordering left out (needs reorder-queue, iptables and the NFQUEUE target)"
-fi
+start_reorder "$REORDER" -p udp --dport $PORT
 run lossy
-if [ "$reorder" = on ]; then
-  kill -INT "$REORDER_PID"; wait "$REORDER_PID" || true
-  cat "$WORK/reorder.out"
-  expect "lidar packets held back and overtaken" "$(awk '/overtaken/ { print $4 }' "$WORK/reorder.out")" ">" 0
-fi
+stop_reorder "lidar packets"
 expect "lossy run: exit code" "$LAUNCH_RC" == 0
 nft list chain ip lossy pre | grep counter | sed 's/^\s*/nft: /'
 # nft's counters: dropped and passed, lidar and IMU, in the order the rules were added.
@@ -65,5 +52,5 @@ expect "lost inputs counted by the feature stage" "$imu_lost" ">" 0
 expect "sweeps published by the lidar bridge (clean: $(fact "$WORK/clean.facts" outputs STATUS_LIDAR_BRIDGE))" \
   "$(fact "$WORK/lossy.facts" outputs STATUS_LIDAR_BRIDGE)" ">=" "$(( $(fact "$WORK/clean.facts" outputs STATUS_LIDAR_BRIDGE) - 2 ))"
 expect_run_survived lossy clean "$LOSS % loss on the sensors' links"
-echo "figure: $LOSS % of the lidar's packets ($lidar_dropped of $((lidar_dropped + lidar_passed))) and of the IMU's messages ($imu_dropped of $((imu_dropped + imu_passed))) lost, reordering $reorder ($REORDER %): the bridge counted $lost_packets lost packets ($(fact "$WORK/lossy.facts" counter STATUS_LIDAR_BRIDGE packet_gap) longer gaps) and published $ARRIVED sweeps to the feature stage (clean: $(fact "$WORK/clean.facts" outputs STATUS_FEATURE)), $late overtaken ones skipped as late, lost_input $imu_lost at the feature stage; APE rmse $RUN_APE m vs $BASELINE_APE m clean"
+echo "figure: $LOSS % of the lidar's packets ($lidar_dropped of $((lidar_dropped + lidar_passed))) and of the IMU's messages ($imu_dropped of $((imu_dropped + imu_passed))) lost, reordering $REORDER_STATE ($REORDER %): the bridge counted $lost_packets lost packets ($(fact "$WORK/lossy.facts" counter STATUS_LIDAR_BRIDGE packet_gap) longer gaps) and published $ARRIVED sweeps to the feature stage (clean: $(fact "$WORK/clean.facts" outputs STATUS_FEATURE)), $late overtaken ones skipped as late, lost_input $imu_lost at the feature stage; APE rmse $RUN_APE m vs $BASELINE_APE m clean"
 exit $failed
