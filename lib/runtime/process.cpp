@@ -1,6 +1,7 @@
 #include "runtime/process.hpp"
 
 #include "runtime/allocator.hpp"
+#include "runtime/resources.hpp"
 #include "runtime/status.hpp"
 
 #include <lcm/lcm-cpp.hpp>
@@ -196,6 +197,7 @@ int runNodeProcess(int argc, char** argv, const std::string& name, const std::st
   auto last_status = start;
   auto last_trim = start;
   MemoryUse memory = returnFreeMemory();
+  ProcessResources resources = readProcessResources();  // read right after the trim, as the memory
   constexpr std::chrono::seconds kReturnFreeMemoryPeriod{30};  // runtime/allocator.hpp
   std::int64_t status_seq = 0, inputs_at_last_status = 0;
   double busy_at_last_status = 0;
@@ -211,7 +213,7 @@ int runNodeProcess(int argc, char** argv, const std::string& name, const std::st
     if (reported == "behind") spdlog::warn("busy {:.0f}% of the time: falling behind its input", busy * 100);
     adit::status_t status = makeStatus(*node, wallUtime(), status_seq++,
                                        std::chrono::duration<double>(now - start).count(), rate, busy, reported);
-    addMemoryCounters(status, memory);
+    addMemoryCounters(status, memory, resources);
     traffic.report(status, window);
     if (probe) probe->report(status);
     const Bytes bytes = msg::encode(status);
@@ -234,6 +236,7 @@ int runNodeProcess(int argc, char** argv, const std::string& name, const std::st
       sendStatus(node->state());
     if (std::chrono::steady_clock::now() - last_trim >= kReturnFreeMemoryPeriod) {
       memory = returnFreeMemory();
+      resources = readProcessResources();
       last_trim = std::chrono::steady_clock::now();
     }
   }

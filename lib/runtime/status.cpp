@@ -79,10 +79,13 @@ void addLatencyCounters(adit::status_t& status, const std::string& name, const L
   status.num_counters = static_cast<std::int32_t>(status.counter_names.size());
 }
 
-void addMemoryCounters(adit::status_t& status, const MemoryUse& memory) {
+void addMemoryCounters(adit::status_t& status, const MemoryUse& memory, const ProcessResources& resources) {
   const std::pair<const char*, std::int64_t> fields[] = {{"memory_resident_kb", memory.resident_kb},
                                                          {"memory_heap_in_use_kb", memory.heap_in_use_kb},
-                                                         {"memory_heap_free_kb", memory.heap_free_kb}};
+                                                         {"memory_heap_free_kb", memory.heap_free_kb},
+                                                         {"memory_anonymous_kb", resources.anonymous_kb},
+                                                         {"threads", resources.threads},
+                                                         {"open_files", resources.open_files}};
   for (const auto& [name, value] : fields) {
     status.counter_names.push_back(name);
     status.counter_values.push_back(value);

@@ -4,6 +4,7 @@
 #include "runtime/allocator.hpp"
 #include "runtime/latency.hpp"
 #include "runtime/node.hpp"
+#include "runtime/resources.hpp"
 
 #include <adit/status_t.hpp>
 
@@ -45,8 +46,9 @@ adit::status_t makeStatus(const std::string& process, const Health& health, cons
 // "_p99_us", "_max_us", and "<name>_samples" (sweeps in the window), "<name>_unmatched" (never completed).
 void addLatencyCounters(adit::status_t& status, const std::string& name, const LatencySummary& latency);
 
-// Appends the process's memory (runtime/allocator.hpp, last measured) to status's named counters:
-// "memory_resident_kb", "memory_heap_in_use_kb", "memory_heap_free_kb".
-void addMemoryCounters(adit::status_t& status, const MemoryUse& memory);
+// Appends the process's memory (runtime/allocator.hpp) and resources (runtime/resources.hpp), last measured, to
+// status's named counters: "memory_resident_kb", "memory_heap_in_use_kb", "memory_heap_free_kb",
+// "memory_anonymous_kb", "threads", "open_files".
+void addMemoryCounters(adit::status_t& status, const MemoryUse& memory, const ProcessResources& resources);
 
 }  // namespace adit::runtime
