@@ -6,6 +6,23 @@
 #include <utility>
 
 namespace adit {
+namespace {
+
+using Key = std::array<long long, 3>;
+
+// The voxel holding p, or false for a point that has none: non-finite, or so far out (|p / voxel| >= 2^62, a
+// corrupt cloud or pose, nowhere near a map) that its index does not fit the key. Such points are dropped.
+bool voxelKeyOf(const Eigen::Vector3f& p, double voxel, Key& key) {
+  constexpr double kLimit = 4.611686018427388e18;  // 2^62
+  for (int d = 0; d < 3; ++d) {
+    const double i = std::floor(static_cast<double>(p[d]) / voxel);
+    if (!(i > -kLimit && i < kLimit)) return false;  // NaN fails too
+    key[static_cast<std::size_t>(d)] = static_cast<long long>(i);
+  }
+  return true;
+}
+
+}  // namespace
 
 std::vector<Eigen::Vector3f> voxelDownsample(const std::vector<Eigen::Vector3f>& points, double voxel) {
   std::vector<Eigen::Vector3f> out;
@@ -14,15 +31,11 @@ std::vector<Eigen::Vector3f> voxelDownsample(const std::vector<Eigen::Vector3f>&
       if (p.allFinite()) out.push_back(p);
     return out;
   }
-  using Key = std::array<long long, 3>;
   std::vector<std::pair<Key, int>> keyed;
   keyed.reserve(points.size());
   for (std::size_t i = 0; i < points.size(); ++i) {
-    const Eigen::Vector3f& p = points[i];
-    if (!p.allFinite()) continue;
     Key k;
-    for (int d = 0; d < 3; ++d) k[static_cast<std::size_t>(d)] = static_cast<long long>(std::floor(p[d] / voxel));
-    keyed.emplace_back(k, static_cast<int>(i));
+    if (voxelKeyOf(points[i], voxel, k)) keyed.emplace_back(k, static_cast<int>(i));
   }
   std::sort(keyed.begin(), keyed.end());
   for (std::size_t i = 0; i < keyed.size();) {
@@ -43,9 +56,8 @@ std::size_t VoxelAccumulator::KeyHash::operator()(const Key& k) const {
 }
 
 void VoxelAccumulator::add(const Eigen::Vector3f& p) {
-  if (!p.allFinite()) return;
   Key k;
-  for (int d = 0; d < 3; ++d) k[static_cast<std::size_t>(d)] = static_cast<long long>(std::floor(p[d] / voxel_));
+  if (!voxelKeyOf(p, voxel_, k)) return;
   Sum& s = cells_[k];
   s.sum += p.cast<double>();
   ++s.count;

@@ -9,7 +9,8 @@
 
 namespace adit {
 
-// Non-finite points are dropped; voxel <= 0 only drops non-finite points.
+// Non-finite points are dropped, and points too far out for a voxel index (|p / voxel| >= 2^62: a corrupt
+// cloud or pose); voxel <= 0 only drops non-finite points.
 std::vector<Eigen::Vector3f> voxelDownsample(const std::vector<Eigen::Vector3f>& points, double voxel);
 
 // The same centroids from points added piece by piece (e.g. keyframe by keyframe), holding one sum per
@@ -18,7 +19,7 @@ std::vector<Eigen::Vector3f> voxelDownsample(const std::vector<Eigen::Vector3f>&
 class VoxelAccumulator {
  public:
   explicit VoxelAccumulator(double voxel) : voxel_(voxel) {}
-  void add(const Eigen::Vector3f& point);  // non-finite points are dropped
+  void add(const Eigen::Vector3f& point);  // dropped as by voxelDownsample
   std::vector<Eigen::Vector3f> centroids() const;  // in voxel-key order
 
  private:

@@ -511,5 +511,21 @@ TEST(VoxelAccumulator, SameCentroidsAsDownsamplingAllPointsAtOnce) {
   EXPECT_EQ(grid.centroids(), voxelDownsample(points, 0.3));
 }
 
+// A corrupt cloud or pose (fuzz_map_bundle: a saved map's neighbour at 1e26 m) must not make the voxel index
+// overflow its integer (undefined behaviour): such points have no voxel and are dropped, the rest kept.
+TEST(VoxelDownsample, DropsPointsTooFarForAVoxelIndex) {
+  const std::vector<Eigen::Vector3f> points = {{1.0f, 2.0f, 3.0f}, {5.5e26f, 0.0f, 0.0f}, {0.0f, -3e38f, 0.0f},
+                                               {1.05f, 2.05f, 3.05f}, {0.0f, 0.0f, 1e17f}};
+  const std::vector<Eigen::Vector3f> kept = voxelDownsample(points, 0.3);
+  // (1, 2, 3) and (1.05, 2.05, 3.05) share a voxel of 0.3 m; 1e17 m is far but its index still fits. In key
+  // order: (0, 0, 3.3e17) before (3, 6, 10).
+  ASSERT_EQ(kept.size(), 2u);
+  EXPECT_NEAR(kept[0].z(), 1e17f, 1e11f);
+  EXPECT_TRUE(kept[1].isApprox(Eigen::Vector3f(1.025f, 2.025f, 3.025f), 1e-6f));
+  VoxelAccumulator grid(0.3);
+  for (const Eigen::Vector3f& p : points) grid.add(p);
+  EXPECT_EQ(grid.centroids(), kept);
+}
+
 }  // namespace
 }  // namespace adit
