@@ -3,6 +3,9 @@
 #include <malloc.h>
 #include <unistd.h>
 
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
 #include <fstream>
 
 namespace adit::runtime {
@@ -13,6 +16,21 @@ void keepFreedMemoryForReuse(std::size_t largest_heap_block) {
   // behaviour does not depend on what was freed first.
   mallopt(M_MMAP_THRESHOLD, static_cast<int>(largest_heap_block));
   mallopt(M_TRIM_THRESHOLD, 256 << 20);
+}
+
+void allocateFromOneHeap() { mallopt(M_ARENA_MAX, 1); }
+
+int heapArenas() {
+  char* text = nullptr;
+  std::size_t size = 0;
+  std::FILE* out = open_memstream(&text, &size);
+  if (!out) return -1;
+  const bool written = malloc_info(0, out) == 0;
+  std::fclose(out);
+  int heaps = 0;
+  for (const char* p = text; written && (p = std::strstr(p, "<heap nr=")) != nullptr; ++p) ++heaps;
+  std::free(text);
+  return written ? heaps : -1;
 }
 
 MemoryUse returnFreeMemory() {

@@ -21,6 +21,17 @@ constexpr std::size_t kShortRunHeapBlock = std::size_t{64} << 20;  // adit repla
 constexpr std::size_t kLongRunHeapBlock = std::size_t{1} << 20;
 void keepFreedMemoryForReuse(std::size_t largest_heap_block = kShortRunHeapBlock);
 
+// Every thread allocates from the main heap: glibc otherwise gives each new thread an arena of its own (a 64 MB
+// reservation, grown and trimmed on its own). A live stage's worker threads (the loop closer's loop jobs, the
+// search threads' index builds) then leave long-lived blocks in several heaps, and each heap fragments around
+// them. Measured in two 30-minute soaks side by side: the loop closer's anonymous memory 11.5 -> 7.3 MB and its
+// freed-but-kept heap 14.3 -> 7.1 MB at 20-30 min, the same memory in use. The cost is one lock for the
+// allocations that miss the thread's cache, a few per sweep in a live stage. Call before any thread starts:
+// a thread already running keeps its arena.
+void allocateFromOneHeap();
+// Heaps (arenas) the allocator has made so far (glibc malloc_info), for tests and diagnostics.
+int heapArenas();
+
 struct MemoryUse {
   std::int64_t resident_kb = 0;      // the process's resident set (/proc/self/statm), after the trim
   std::int64_t heap_in_use_kb = 0;   // allocated and not freed (every arena, mmapped blocks included)

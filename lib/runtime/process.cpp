@@ -144,6 +144,7 @@ void applyRemaps(Node& node, const std::vector<std::string>& remaps) {
 int runNodeProcess(int argc, char** argv, const std::string& name, const std::string& description,
                    const NodeFactory& factory) {
   keepFreedMemoryForReuse(kLongRunHeapBlock);
+  allocateFromOneHeap();
   CLI::App app{description, "adit-" + name};
   ProcessOptions options;
   addProcessOptions(app, options);
