@@ -62,8 +62,13 @@ struct LoopCloserConfig {
   // keeps only its pose-graph node: its cloud and Scan Context serve its own loop search, then are dropped. The
   // map of a place is its first visit's. A robot patrolling a mapped roadway for hours then adds a graph node
   // (< 1 kB) per keyframe instead of ~40 kB. 0 keeps every keyframe's cloud.
+  // On a patrolled loop, loops come a few keyframes apart but pause now and then for 30-60 keyframes (aliased
+  // or rejected candidates); with a trust of 30 every such pause kept clouds on mapped roadway, and those
+  // keyframes stayed in the graph for good and became later laps' loop matches: an hour of roadway-loop kept
+  // 643 clouds (145 of them such lapses) and 872 graph nodes, APE 0.182 m. With 60: 498 clouds (5 lapses),
+  // 722 nodes, APE 0.102 m. The mapper drifts ~0.3 % over those 60 m, far less than revisit_distance.
   double revisit_distance = 1.0;
-  int revisit_trust_keyframes = 30;
+  int revisit_trust_keyframes = 60;
   // A keyframe without a cloud (a revisit) older than the newest retire_after_keyframes is merged out of the
   // pose graph (loop/graph_merge.hpp), retire_batch at a time: the graph, the odometry chain and the Scan
   // Context database then follow the roadway mapped too, and the keyframe leaves only its final correction
