@@ -24,7 +24,7 @@ namespace {
   int allocated = 0;
   std::vector<std::thread> running;
   for (int t = 0; t < threads; ++t)
-    running.emplace_back([&] {
+    running.emplace_back([&, t] {
       std::vector<int> blocks(1000, t);  // a thread's first allocation is when glibc gives it a heap
       std::unique_lock<std::mutex> lock(mutex);
       ++allocated;
