@@ -53,10 +53,14 @@ class BoundedKnn {
 
 }  // namespace
 
+// Points per leaf. Searches are exact, so this moves only cost: a sweep's trees are built once and queried a
+// few thousand times, and the build was the larger part (16 measured cheaper than 8, 12 and 32 in a replay).
+constexpr std::size_t kLeafSize = 16;
+
 struct KdTree3::Index {
   std::vector<Eigen::Vector3d> points;
   PointsAdaptor adaptor{points};
-  Tree tree{3, adaptor, nanoflann::KDTreeSingleIndexAdaptorParams(8)};
+  Tree tree{3, adaptor, nanoflann::KDTreeSingleIndexAdaptorParams(kLeafSize)};
   explicit Index(std::vector<Eigen::Vector3d> p) : points(std::move(p)) { tree.buildIndex(); }
 };
 

@@ -1,4 +1,4 @@
-// A static 3-D KD-tree (nanoflann, leaves of up to 8 points) for nearest-neighbour queries: one sweep's
+// A static 3-D KD-tree (nanoflann, leaves of up to 16 points) for nearest-neighbour queries: one sweep's
 // feature points in odometry, a keyframe submap in loop verification.
 //
 // Built once (median splits, no randomness) and queried a few thousand times. Deterministic: equal distances
