@@ -527,5 +527,26 @@ TEST(VoxelDownsample, DropsPointsTooFarForAVoxelIndex) {
   EXPECT_EQ(grid.centroids(), kept);
 }
 
+// Clouds near the origin take a packed one-integer voxel key; one point beyond +-2^20 voxels sends the whole
+// cloud through the three-integer key. Both must give the same centroids in the same order, bit for bit.
+TEST(VoxelDownsample, PackedAndWideKeysGiveTheSameCentroids) {
+  std::vector<Eigen::Vector3f> near;
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<float> coord(-5.0f, 5.0f);
+  for (int i = 0; i < 5000; ++i) near.emplace_back(coord(rng), coord(rng), 0.1f * coord(rng));
+  const std::vector<Eigen::Vector3f> packed = voxelDownsample(near, 0.25);
+  std::vector<Eigen::Vector3f> with_far = near;
+  with_far.emplace_back(1e6f, 0.0f, 0.0f);  // voxel 4e6: beyond the packed range, and last in key order
+  std::vector<Eigen::Vector3f> wide = voxelDownsample(with_far, 0.25);
+  ASSERT_EQ(wide.size(), packed.size() + 1);
+  EXPECT_EQ(wide.back(), with_far.back());
+  wide.pop_back();
+  EXPECT_EQ(wide, packed);
+  EXPECT_LT(packed.size(), near.size() * 3 / 4);  // voxels were shared: the sums and their order were exercised
+  VoxelAccumulator grid(0.25);  // the accumulator (three-integer keys) agrees too
+  for (const Eigen::Vector3f& p : near) grid.add(p);
+  EXPECT_EQ(grid.centroids(), packed);
+}
+
 }  // namespace
 }  // namespace adit
