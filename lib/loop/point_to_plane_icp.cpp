@@ -27,8 +27,9 @@ PlaneTarget::PlaneTarget(const std::vector<Eigen::Vector3f>& points, const IcpCo
   if (static_cast<int>(finite.size()) < k) return;
   const KdTree3 all(finite);
   std::vector<Eigen::Vector3d> planar;
+  std::vector<int> idx;  // reused: no allocation per point
   for (const Eigen::Vector3d& p : finite) {
-    const std::vector<int> idx = all.nearestK(p, k, std::numeric_limits<double>::infinity());
+    all.nearestK(p, k, std::numeric_limits<double>::infinity(), idx);
     if (static_cast<int>(idx.size()) < k) continue;
     Eigen::Vector3d mean = Eigen::Vector3d::Zero();
     for (int i : idx) mean += all.point(i);
