@@ -54,7 +54,8 @@ class BoundedKnn {
 }  // namespace
 
 // Points per leaf. Searches are exact, so this moves only cost: a sweep's trees are built once and queried a
-// few thousand times, and the build was the larger part (16 measured cheaper than 8, 12 and 32 in a replay).
+// few thousand times, and the build was the larger part (16 measured cheaper than 8 in a replay; 12 and 32 were
+// not told apart from 16 on the same machine, see README "Measured speed").
 constexpr std::size_t kLeafSize = 16;
 
 struct KdTree3::Index {
