@@ -34,6 +34,7 @@ MapperConfig aloamMapperConfig() {
   m.registration.max_solver_iterations = 4;
   m.registration.reuse_match_distance_m = 0.0;  // A-LOAM searches every round afresh
   m.plane_through_nearest = false;
+  m.line_through_nearest = false;
   m.thin_within_sweep = true;
   return m;
 }
@@ -53,6 +54,7 @@ const ConfigTable<MapperConfig>& mapperConfigTable() {
      .add("line_eigen_ratio", &M::line_eigen_ratio, atLeast(1), "", "edge if the largest eigenvalue exceeds ratio * the second (A-LOAM: 3)")
      .add("plane_max_point_distance_m", &M::plane_max_point_distance_m, above(0), "m", "a plane is rejected if a neighbour is farther (A-LOAM: 0.2)")
      .add("plane_through_nearest", &M::plane_through_nearest, anyValue(), "", "a surface match's plane passes through the nearest map point, not the neighbours' centroid (A-LOAM: false)")
+     .add("line_through_nearest", &M::line_through_nearest, anyValue(), "", "an edge match's line passes through the nearest map point, not the neighbours' centroid (A-LOAM: false)")
      .add("thin_within_sweep", &M::thin_within_sweep, anyValue(), "", "a sweep's points are also thinned against each other as they enter the local map, not only against earlier sweeps (A-LOAM; 64 beams)")
      .add("local_map_radius_m", &M::local_map_radius_m, above(0), "m", "map points farther from the robot are dropped (bounds memory)")
      .add("global_map_resolution_m", &M::global_map_resolution_m, between(0.01, 100), "m", "resolution of the saved global map")
@@ -86,8 +88,10 @@ Correspondences ScanToMapMapper::match(const std::vector<Eigen::Vector3d>& corne
       thread_local std::vector<Eigen::Vector3d> near;
       corner_map_.nearest(q, k, config_.max_neighbour_distance_m, near);
       if (static_cast<int>(near.size()) < k) return std::nullopt;
-      if (const auto line = fitLine(near, config_.line_eigen_ratio)) return LineMatch{corners[i], line->centroid, line->direction};
-      return std::nullopt;
+      const auto line = fitLine(near, config_.line_eigen_ratio);
+      if (!line) return std::nullopt;
+      // VoxelMap::nearest lists the neighbours nearest first.
+      return LineMatch{corners[i], config_.line_through_nearest ? near.front() : line->centroid, line->direction};
     };
     addMatch(reuse, i, T * corners[i], lines, search);
   };

@@ -267,11 +267,14 @@ TEST_F(Cli, DemoEndsWithAReportAndPlots) {
     EXPECT_NE(report.find(line), std::string::npos) << line << " missing in:\n" << report;
   for (const char* file : {"map.pcd", "trajectory.tum", "odometry.tum", "ground_truth.tum", "trajectory.png", "map.png"})
     EXPECT_TRUE(fs::exists(out / file)) << file;
-  // The saved map against the simulator's surfaces (measured: 0.024 m mean over 12 s, nothing beyond 0.2 m).
+  // The saved map against the simulator's surfaces (measured: 0.038 m mean over 12 s, 0.01 % of the points
+  // beyond 0.2 m, with the mapper's edge lines through the nearest map point; 0.028 m and 0.00 % without).
   const std::size_t at = report.find("map against world");
   ASSERT_NE(at, std::string::npos) << report;
   EXPECT_LT(std::stod(report.substr(at + 17)), 0.06) << report;
-  EXPECT_NE(report.find(" 0.00 % of ", at), std::string::npos) << report;
+  const std::size_t share = report.find(" % of ", at), start = report.rfind(' ', share - 1);
+  ASSERT_NE(share, std::string::npos) << report;
+  EXPECT_LT(std::stod(report.substr(start + 1, share - start - 1)), 0.05) << report;
 }
 
 // --extend joins the run to a saved map: without the map (--prior-map) or a place for the result (--save-bundle)

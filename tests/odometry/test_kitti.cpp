@@ -25,13 +25,14 @@ struct PairErrors {
   int seeded_by_link3d = 0, failed = 0;
 };
 
-// 64-beam settings: A-LOAM's HDL-64 map resolutions; planes through the neighbours' centroid and a sweep's
-// points thinned against each other in the local map (as launch/sensors/hdl64.yaml).
+// 64-beam settings: A-LOAM's HDL-64 map resolutions; planes and lines through the neighbours' centroid and a
+// sweep's points thinned against each other in the local map (as launch/sensors/hdl64.yaml).
 MapperConfig kittiMapperConfig() {
   MapperConfig m;
   m.corner_resolution_m = 0.4;
   m.surf_resolution_m = 0.8;
   m.plane_through_nearest = false;
+  m.line_through_nearest = false;
   m.thin_within_sweep = true;
   return m;
 }
