@@ -47,4 +47,14 @@ std::vector<Eigen::Vector3f> CompactCloud::decode() const {
   return out;
 }
 
+double CompactCloud::maxNorm() const {
+  std::int64_t largest = 0;  // squared count vector: at most 3 * 32768^2, exact in 64 bits
+  for (std::size_t i = 0; i + 2 < counts_.size(); i += 3) {
+    const std::int64_t x = counts_[i], y = counts_[i + 1], z = counts_[i + 2];
+    largest = std::max(largest, x * x + y * y + z * z);
+  }
+  // decode() multiplies in float: a relative rounding of 2^-24 per coordinate, covered with a wide margin.
+  return std::sqrt(static_cast<double>(largest)) * static_cast<double>(step_) * (1.0 + 1e-5);
+}
+
 }  // namespace adit

@@ -24,6 +24,8 @@ class CompactCloud {
   static std::optional<CompactCloud> fromCounts(float step, std::vector<std::int16_t> counts);
 
   std::vector<Eigen::Vector3f> decode() const;
+  // No decoded point lies farther than this from the origin (m); 0 for an empty cloud. From the counts alone.
+  double maxNorm() const;
   std::size_t size() const { return counts_.size() / 3; }
   bool empty() const { return counts_.empty(); }
   float step() const { return step_; }

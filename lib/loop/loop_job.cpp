@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 #include <memory>
+#include <optional>
 
 namespace adit {
 namespace {
@@ -52,6 +53,10 @@ class JobRun {
     // Seeds: the Scan Context yaw, then the graph's current relative pose (then LinK3D's, see verification()).
     const int m = c.candidate.index;
     const Eigen::Isometry3d T_graph = job_.graph.pose(m).inverse() * job_.graph.pose(job_.query);
+    if (gateRefusesEveryFit(c, T_graph)) {
+      ++counts_.rejected_odometry;
+      return std::nullopt;
+    }
     const std::vector<Eigen::Isometry3d> seeds{
         scanContextSeed(job_.query_uncorrected, c.match_uncorrected, c.candidate.yaw, config_.level_scan_context),
         T_graph};
@@ -70,6 +75,47 @@ class JobRun {
     }
     if (!a.loop && !b.loop) ++counts_.rejected_odometry;
     return a.loop ? a.loop : b.loop;
+  }
+
+  // True when the odometry gate would refuse any fit the verifier could accept (judge()), so ICP need not run:
+  // most Scan Context candidates of a long aliased roadway lie tens to hundreds of metres away by the graph
+  // (on issue 16's 700 s drive 1,109 of 1,194 fits were refused there after a full ICP). An accepted or
+  // degenerate fit has inliers, so some query point lands within the fine correspondence distance of a submap
+  // point: the query's origin lies within that distance plus the two clouds' extents of the match keyframe.
+  bool gateRefusesEveryFit(const LoopCandidateSnapshot& c, const Eigen::Isometry3d& T_graph) {
+    const double ratio = config_.verifier.min_inlier_ratio;
+    if (!(ratio > 0.0)) return false;  // a fit without inliers could be anywhere
+    if (!query_reach_) query_reach_ = innerQueryRadius(querySourceOnce(), ratio);
+    double submap_extent = 0.0;
+    for (std::size_t i = 0; i < c.neighbourhood.clouds.size() && i < c.neighbourhood.T_match_cloud.size(); ++i)
+      submap_extent = std::max(submap_extent, c.neighbourhood.T_match_cloud[i].translation().norm() +
+                                                  c.neighbourhood.clouds[i].maxNorm());
+    const double reach = *query_reach_ + submap_extent + config_.verifier.icp.fine_correspondence_distance;
+    const double offset = config_.partial_loops ? config_.partial_loop_max_axis_offset : 0.0;
+    const double bound = loopChi2LowerBound(T_graph.translation().norm(), reach, offset,
+                                            job_.chain.covarianceBetween(c.candidate.index, job_.query),
+                                            loopMeasurementCovariance(config_));
+    return bound > config_.max_odometry_chi2;
+  }
+
+  // A radius within which lie more of the source's points than a fit may leave without inliers: at least one
+  // inlier of any fit the verifier accepts is that close to the query's origin.
+  static double innerQueryRadius(const std::vector<Eigen::Vector3f>& source, double min_inlier_ratio) {
+    if (source.empty()) return 0.0;
+    std::vector<float> norms;
+    norms.reserve(source.size());
+    for (const Eigen::Vector3f& p : source) norms.push_back(p.norm());
+    // One point more than (1 - ratio) of them (and one more for the rounding of the ratio's comparison).
+    const double outside = std::floor((1.0 - min_inlier_ratio) * static_cast<double>(norms.size())) + 1.0;
+    const auto k = static_cast<std::size_t>(std::min(outside, static_cast<double>(norms.size() - 1)));
+    std::nth_element(norms.begin(), norms.begin() + static_cast<std::ptrdiff_t>(k), norms.end());
+    return static_cast<double>(norms[k]) * (1.0 + 1e-6);
+  }
+
+  // The ICP source of the job's query, made once for all its candidates.
+  const std::vector<Eigen::Vector3f>& querySourceOnce() {
+    if (!query_source_) query_source_ = querySource(job_.query_cloud.decode(), config_.verifier);
+    return *query_source_;
   }
 
   // A verified fit as a loop constraint, or the counter of why it is none.
@@ -121,7 +167,7 @@ class JobRun {
   // only copies the compact clouds into the job.
   std::vector<LoopVerification> verification(const LoopCandidateSnapshot& c, const std::vector<Eigen::Isometry3d>& seeds) {
     const std::unique_ptr<PlaneTarget> target = candidateTarget(c.neighbourhood, config_.verifier);
-    const std::vector<Eigen::Vector3f> source = querySource(job_.query_cloud.decode(), config_.verifier);
+    const std::vector<Eigen::Vector3f>& source = querySourceOnce();
     const LoopVerification v = verifyLoopAgainst(*target, source, seeds, config_.verifier);
     const KeypointSeedConfig& k = config_.keypoints;
     if (!k.use || !job_.query_keypoints || v.verdict == LoopVerdict::kTooFewPoints ||
@@ -203,6 +249,8 @@ class JobRun {
   LoopBook& book_;
   const LoopCloserConfig& config_;
   LoopCloserStats counts_;
+  std::optional<std::vector<Eigen::Vector3f>> query_source_;  // querySourceOnce()
+  std::optional<double> query_reach_;                          // innerQueryRadius of it, once needed
 };
 
 }  // namespace

@@ -34,6 +34,15 @@ class OdometryChain {
 double loopChi2(const Eigen::Isometry3d& Z, const Eigen::Isometry3d& T_match_query_graph,
                 const Matrix6d& chain_covariance, const Matrix6d& loop_covariance);
 
+// A lower bound on loopChi2 for every fit a verifier could return, known before it runs: the fit puts the query
+// within max_fit_distance of the match keyframe, while the graph puts it graph_distance away. With
+// partial_axis_offset > 0 the fit may also be a partial loop (loop_job.cpp): free along an axis a that the graph
+// crosses by at most that offset, its residual projected off a and its covariance inflated along a, so the
+// bound holds for those too (README, "Measured speed": the derivation). loop_covariance is the full loop's.
+// 0 when the distances do not separate the two.
+double loopChi2LowerBound(double graph_distance, double max_fit_distance, double partial_axis_offset,
+                          const Matrix6d& chain_covariance, const Matrix6d& loop_covariance);
+
 // Chi-square of the cycle closed by two loops (m_a -> q_a and m_b -> q_b): the query-side relative pose must
 // equal Z_a^-1 * T_ma_mb * Z_b.
 double pairChi2(const Eigen::Isometry3d& Z_a, const Eigen::Isometry3d& Z_b, const Eigen::Isometry3d& T_ma_mb,

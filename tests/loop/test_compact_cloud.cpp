@@ -43,6 +43,18 @@ TEST(CompactCloud, RoundTripWithinHalfAStep) {
   expectWithinHalfStep(points, c);
 }
 
+// maxNorm, from the counts alone, bounds every decoded point and is no looser than the rounding margin.
+TEST(CompactCloud, MaxNormBoundsEveryDecodedPoint) {
+  for (const float reach : {0.5f, 40.0f, 300.0f}) {
+    const CompactCloud c = CompactCloud::encode(randomCloud(2000, reach, 7), 0.005f);
+    double farthest = 0.0;
+    for (const Eigen::Vector3f& p : c.decode()) farthest = std::max(farthest, static_cast<double>(p.norm()));
+    EXPECT_GE(c.maxNorm(), farthest) << reach;
+    EXPECT_LE(c.maxNorm(), farthest * (1.0 + 1e-4)) << reach;
+  }
+  EXPECT_EQ(CompactCloud().maxNorm(), 0.0);
+}
+
 TEST(CompactCloud, FarPointsCoarsenTheStepInsteadOfOverflowing) {
   auto points = randomCloud(1000, 50.0f, 2);
   points.emplace_back(-400.0f, 0.0f, 1.0f);  // 80,000 steps of 5 mm: beyond int16
