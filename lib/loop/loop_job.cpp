@@ -53,7 +53,9 @@ class JobRun {
     // Seeds: the Scan Context yaw, then the graph's current relative pose (then LinK3D's, see verification()).
     const int m = c.candidate.index;
     const Eigen::Isometry3d T_graph = job_.graph.pose(m).inverse() * job_.graph.pose(job_.query);
-    if (gateRefusesEveryFit(c, T_graph)) {
+    // The graph's uncertainty between the two keyframes, summed along the chain once for the gate and the fits.
+    const Matrix6d chain = job_.chain.covarianceBetween(m, job_.query);
+    if (gateRefusesEveryFit(c, T_graph, chain)) {
       ++counts_.rejected_odometry;
       return std::nullopt;
     }
@@ -62,13 +64,13 @@ class JobRun {
         T_graph};
     const std::vector<LoopVerification> fits = verification(c, seeds);
     if (fits.size() == 1) {
-      const Judged j = judge(c, fits[0], T_graph);
+      const Judged j = judge(c, fits[0], T_graph, chain);
       if (j.rejection) ++*j.rejection;
       return j.loop;
     }
     // Two accepted fits in different places (the keypoints' and the other seeds'): the odometry may tell them
     // apart; if it allows both, the place is aliased and neither is trusted.
-    const Judged a = judge(c, fits[0], T_graph), b = judge(c, fits[1], T_graph);
+    const Judged a = judge(c, fits[0], T_graph, chain), b = judge(c, fits[1], T_graph, chain);
     if (a.loop && b.loop) {
       ++counts_.rejected_ambiguous;
       return std::nullopt;
@@ -82,7 +84,7 @@ class JobRun {
   // (on issue 16's 700 s drive 1,109 of 1,194 fits were refused there after a full ICP). An accepted or
   // degenerate fit has inliers, so some query point lands within the fine correspondence distance of a submap
   // point: the query's origin lies within that distance plus the two clouds' extents of the match keyframe.
-  bool gateRefusesEveryFit(const LoopCandidateSnapshot& c, const Eigen::Isometry3d& T_graph) {
+  bool gateRefusesEveryFit(const LoopCandidateSnapshot& c, const Eigen::Isometry3d& T_graph, const Matrix6d& chain) {
     const double ratio = config_.verifier.min_inlier_ratio;
     if (!(ratio > 0.0)) return false;  // a fit without inliers could be anywhere
     if (!query_reach_) query_reach_ = innerQueryRadius(querySourceOnce(), ratio);
@@ -92,9 +94,8 @@ class JobRun {
                                                   c.neighbourhood.clouds[i].maxNorm());
     const double reach = *query_reach_ + submap_extent + config_.verifier.icp.fine_correspondence_distance;
     const double offset = config_.partial_loops ? config_.partial_loop_max_axis_offset : 0.0;
-    const double bound = loopChi2LowerBound(T_graph.translation().norm(), reach, offset,
-                                            job_.chain.covarianceBetween(c.candidate.index, job_.query),
-                                            loopMeasurementCovariance(config_));
+    const double bound =
+        loopChi2LowerBound(T_graph.translation().norm(), reach, offset, chain, loopMeasurementCovariance(config_));
     return bound > config_.max_odometry_chi2;
   }
 
@@ -124,7 +125,8 @@ class JobRun {
     int* rejection = nullptr;
   };
 
-  Judged judge(const LoopCandidateSnapshot& c, const LoopVerification& v, const Eigen::Isometry3d& T_graph) {
+  Judged judge(const LoopCandidateSnapshot& c, const LoopVerification& v, const Eigen::Isometry3d& T_graph,
+               const Matrix6d& chain) {
     const int m = c.candidate.index;
     const bool partial = v.verdict == LoopVerdict::kDegenerate && config_.partial_loops &&
                          pinsAllButOneTranslation(v.icp.observability, config_.verifier);
@@ -142,7 +144,7 @@ class JobRun {
       T_match_query.translation() += axis * (graph_along - axis.dot(T_match_query.translation()));
       loop_cov = partialLoopCovariance(config_, T_match_query.linear().transpose() * axis);
     }
-    const double chi2 = loopChi2(T_match_query, T_graph, job_.chain.covarianceBetween(m, job_.query), loop_cov);
+    const double chi2 = loopChi2(T_match_query, T_graph, chain, loop_cov);
     if (!(chi2 <= config_.max_odometry_chi2)) return {std::nullopt, &counts_.rejected_odometry};
     LoopConstraint loop;
     loop.query_index = job_.query;

@@ -272,8 +272,9 @@ TEST_F(Cli, DemoEndsWithAReportAndPlots) {
   const std::size_t at = report.find("map against world");
   ASSERT_NE(at, std::string::npos) << report;
   EXPECT_LT(std::stod(report.substr(at + 17)), 0.06) << report;
-  const std::size_t share = report.find(" % of ", at), start = report.rfind(' ', share - 1);
+  const std::size_t share = report.find(" % of ", at);
   ASSERT_NE(share, std::string::npos) << report;
+  const std::size_t start = report.rfind(' ', share - 1);
   EXPECT_LT(std::stod(report.substr(start + 1, share - start - 1)), 0.05) << report;
 }
 
