@@ -10,26 +10,26 @@ namespace adit {
 namespace {
 
 struct PointsAdaptor {
-  const std::vector<Eigen::Vector3d>& points;
+  const std::vector<Eigen::Vector3f>& points;
   std::size_t kdtree_get_point_count() const { return points.size(); }
-  double kdtree_get_pt(std::uint32_t i, std::size_t dim) const { return points[i][static_cast<Eigen::Index>(dim)]; }
+  float kdtree_get_pt(std::uint32_t i, std::size_t dim) const { return points[i][static_cast<Eigen::Index>(dim)]; }
   template <class Box>
   bool kdtree_get_bbox(Box&) const { return false; }
 };
 
-using Tree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<double, PointsAdaptor>, PointsAdaptor, 3,
+using Tree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<float, PointsAdaptor, float>, PointsAdaptor, 3,
                                                  std::uint32_t>;
 
 // The k best below a bound, skipping one index: nanoflann's result-set interface. The search prunes with
 // worstDist(), so the bound also makes it faster.
 class BoundedKnn {
  public:
-  BoundedKnn(int k, double max_sq, std::int64_t exclude, double* dists, std::uint32_t* indices)
+  BoundedKnn(int k, float max_sq, std::int64_t exclude, float* dists, std::uint32_t* indices)
       : k_(k), max_sq_(max_sq), exclude_(exclude), dists_(dists), indices_(indices) {}
   std::size_t size() const { return static_cast<std::size_t>(count_); }
   bool full() const { return count_ == k_; }
-  double worstDist() const { return count_ < k_ ? max_sq_ : dists_[k_ - 1]; }
-  bool addPoint(double dist, std::uint32_t index) {
+  float worstDist() const { return count_ < k_ ? max_sq_ : dists_[k_ - 1]; }
+  bool addPoint(float dist, std::uint32_t index) {
     if (!(dist < worstDist()) || static_cast<std::int64_t>(index) == exclude_) return true;
     int i = std::min(count_, k_ - 1);
     for (; i > 0 && dists_[i - 1] > dist; --i) {  // equal distances keep the earlier-met point first
@@ -44,9 +44,9 @@ class BoundedKnn {
 
  private:
   int k_;
-  double max_sq_;
+  float max_sq_;
   std::int64_t exclude_;
-  double* dists_;
+  float* dists_;
   std::uint32_t* indices_;
   int count_ = 0;
 };
@@ -60,9 +60,14 @@ constexpr std::size_t kLeafSize = 16;
 
 struct KdTree3::Index {
   std::vector<Eigen::Vector3d> points;
-  PointsAdaptor adaptor{points};
+  std::vector<Eigen::Vector3f> coords;  // what the tree searches: half the bytes of the doubles
+  PointsAdaptor adaptor{coords};
   Tree tree{3, adaptor, nanoflann::KDTreeSingleIndexAdaptorParams(kLeafSize)};
-  explicit Index(std::vector<Eigen::Vector3d> p) : points(std::move(p)) { tree.buildIndex(); }
+  explicit Index(std::vector<Eigen::Vector3d> p) : points(std::move(p)) {
+    coords.reserve(points.size());
+    for (const Eigen::Vector3d& q : points) coords.push_back(q.cast<float>());
+    tree.buildIndex();
+  }
 };
 
 KdTree3::KdTree3(std::vector<Eigen::Vector3d> points) {
@@ -73,10 +78,11 @@ const std::vector<Eigen::Vector3d>& KdTree3::points() const { return index_->poi
 
 int KdTree3::nearest(const Eigen::Vector3d& query, double max_sq_distance, int exclude) const {
   if (!index_ || !query.allFinite()) return -1;
-  double dist = 0.0;
+  float dist = 0.0f;
   std::uint32_t index = 0;
-  BoundedKnn result(1, max_sq_distance, exclude, &dist, &index);
-  index_->tree.findNeighbors(result, query.data(), nanoflann::SearchParams(32, 0.0f, false));
+  BoundedKnn result(1, static_cast<float>(max_sq_distance), exclude, &dist, &index);
+  const Eigen::Vector3f q = query.cast<float>();
+  index_->tree.findNeighbors(result, q.data(), nanoflann::SearchParams(32, 0.0f, false));
   return result.size() > 0 ? static_cast<int>(index) : -1;
 }
 
@@ -84,11 +90,11 @@ void KdTree3::nearestK(const Eigen::Vector3d& query, int k, double max_sq_distan
   out.clear();
   if (!index_ || k <= 0 || !query.allFinite()) return;
   constexpr int kStack = 64;
-  double dists[kStack];
+  float dists[kStack];
   std::uint32_t indices[kStack];
-  std::vector<double> more_dists;
+  std::vector<float> more_dists;
   std::vector<std::uint32_t> more_indices;
-  double* d = dists;
+  float* d = dists;
   std::uint32_t* idx = indices;
   if (k > kStack) {
     more_dists.resize(static_cast<std::size_t>(k));
@@ -96,8 +102,9 @@ void KdTree3::nearestK(const Eigen::Vector3d& query, int k, double max_sq_distan
     d = more_dists.data();
     idx = more_indices.data();
   }
-  BoundedKnn result(k, max_sq_distance, -1, d, idx);
-  index_->tree.findNeighbors(result, query.data(), nanoflann::SearchParams(32, 0.0f, false));
+  BoundedKnn result(k, static_cast<float>(max_sq_distance), -1, d, idx);
+  const Eigen::Vector3f q = query.cast<float>();
+  index_->tree.findNeighbors(result, q.data(), nanoflann::SearchParams(32, 0.0f, false));
   for (std::size_t i = 0; i < result.size(); ++i) out.push_back(static_cast<int>(idx[i]));
 }
 
