@@ -2,6 +2,7 @@
 // a simulated 16-beam sweep (target <= 5 ms) and a real 64-beam KITTI sweep (target <= 25 ms).
 #include "features/feature_extractor.hpp"
 #include "features/link3d_match.hpp"
+#include "features/preprocess.hpp"
 #include "io/kitti.hpp"
 #include "synthetic_scans.hpp"
 
@@ -62,6 +63,21 @@ void BM_FeatureStageKitti64Beam(benchmark::State& state) {
   state.counters["keypoints"] = static_cast<double>(keypoints);
 }
 BENCHMARK(BM_FeatureStageKitti64Beam)->Unit(benchmark::kMillisecond);
+
+// The feature node's thinning of the deskewed sweep to the maps' 0.1 m (FEATURES' map_cloud).
+void BM_MapCloudVoxel16Beam(benchmark::State& state) {
+  const FeatureExtractor fx{FeatureConfig{}};
+  const FeatureSet f = fx.process(sixteenBeamSweep(), {}, walkingPrior());
+  std::size_t kept = 0;
+  for (auto _ : state) {
+    const std::vector<LidarPoint> thinned = features::voxelDownsample(f.cloud.points, 0.1f);
+    kept = thinned.size();
+    benchmark::DoNotOptimize(thinned.data());
+  }
+  state.counters["points"] = static_cast<double>(f.cloud.points.size());
+  state.counters["kept"] = static_cast<double>(kept);
+}
+BENCHMARK(BM_MapCloudVoxel16Beam)->Unit(benchmark::kMicrosecond);
 
 // Matching + RANSAC between two consecutive KITTI sweeps (what odometry adds per sweep for its seed).
 void BM_LinK3dMatchAndRansacKitti(benchmark::State& state) {
