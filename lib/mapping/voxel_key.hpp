@@ -25,6 +25,16 @@ struct VoxelKeyHash {
   }
 };
 
+// The spatial hash mixed so that its low bits, which pick a slot of an open-addressing table, depend on
+// every bit of the key.
+inline std::size_t mixedVoxelHash(const VoxelKey& key) {
+  std::uint64_t h = VoxelKeyHash{}(key);
+  h ^= h >> 31;
+  h *= 0xbf58476d1ce4e5b9ULL;
+  h ^= h >> 29;
+  return static_cast<std::size_t>(h);
+}
+
 // Voxel index of one coordinate, clamped so that the cast cannot overflow (a tiny voxel or a far point; a
 // NaN lands in voxel 0) and a neighbour index (+-1) still fits in 32 bits.
 inline std::int32_t voxelIndex(double coordinate, double voxel_size) {

@@ -7,15 +7,6 @@ namespace {
 
 constexpr std::size_t kInitialSlots = 64;
 
-// The spatial hash mixed so that its low bits, which pick the slot, depend on every bit of the key.
-std::size_t mixedHash(const VoxelKey& key) {
-  std::uint64_t h = VoxelKeyHash{}(key);
-  h ^= h >> 31;
-  h *= 0xbf58476d1ce4e5b9ULL;
-  h ^= h >> 29;
-  return static_cast<std::size_t>(h);
-}
-
 }  // namespace
 
 VoxelMap::VoxelMap(double voxel_size, double min_spacing, int max_points_per_voxel)
@@ -26,7 +17,7 @@ VoxelMap::VoxelMap(double voxel_size, double min_spacing, int max_points_per_vox
 
 std::size_t VoxelMap::slotOf(const VoxelKey& key) const {
   const std::size_t mask = table_.size() - 1;
-  std::size_t slot = mixedHash(key) & mask;
+  std::size_t slot = mixedVoxelHash(key) & mask;
   while (table_[slot] != kEmpty && !(voxels_[static_cast<std::size_t>(table_[slot])].key == key)) slot = (slot + 1) & mask;
   return slot;
 }
@@ -59,7 +50,7 @@ void VoxelMap::eraseSlot(std::size_t slot) {
   const std::size_t mask = table_.size() - 1;
   table_[slot] = kEmpty;
   for (std::size_t next = (slot + 1) & mask; table_[next] != kEmpty; next = (next + 1) & mask) {
-    const std::size_t home = mixedHash(voxels_[static_cast<std::size_t>(table_[next])].key) & mask;
+    const std::size_t home = mixedVoxelHash(voxels_[static_cast<std::size_t>(table_[next])].key) & mask;
     const bool stays = slot <= next ? (slot < home && home <= next) : (slot < home || home <= next);
     if (stays) continue;
     table_[slot] = table_[next];

@@ -1,6 +1,7 @@
 // Scan-to-map mapping over a long synthetic roadway drive: bounded local map, small drift, loop-closure
 // corrections move the map and future poses, deterministic global map output.
 #include "core/geometry.hpp"
+#include "mapping/downsample.hpp"
 #include "mapping/scan_to_map.hpp"
 #include "mapping/voxel_map.hpp"
 #include "odometry/scan_to_scan.hpp"
@@ -11,6 +12,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
+#include <map>
 
 namespace adit {
 namespace {
@@ -209,6 +212,44 @@ TEST(VoxelMap, QueriesMatchABruteForceSearchThroughInsertionsAndRemovals) {
       const std::vector<Eigen::Vector3d> found = map.nearest(query, 5, 1.0);
       ASSERT_EQ(found.size(), brute.size()) << "step " << step;
       for (std::size_t i = 0; i < found.size(); ++i) ASSERT_DOUBLE_EQ((found[i] - query).squaredNorm(), brute[i]);
+    }
+  }
+}
+
+// The mapper's thinning is the plain definition: per voxel the mean of its points summed in input order, the
+// voxels sorted by key, non-finite points dropped; checked bit for bit against a std::map over a cloud that
+// puts many points in some voxels, one in others, points on voxel faces and negative coordinates.
+TEST(VoxelDownsample, IsTheCentroidPerVoxelInKeyOrder) {
+  std::uint64_t state = 777;
+  const auto uniform = [&state](double lo, double hi) {
+    state = state * 6364136223846793005ULL + 1442695040888963407ULL;
+    return lo + (hi - lo) * static_cast<double>(state >> 11) / static_cast<double>(1ULL << 53);
+  };
+  for (const double voxel : {0.2, 0.5}) {
+    std::vector<Eigen::Vector3d> points;
+    for (int i = 0; i < 5000; ++i) {
+      const double spread = i % 3 == 0 ? 0.3 : 20.0;  // a dense clump and a sparse field
+      points.emplace_back(uniform(-spread, spread), uniform(-spread, spread), uniform(-2, 2));
+    }
+    for (int i = 0; i < 20; ++i) points.emplace_back(voxel * i, -voxel * i, 0.0);  // exactly on faces
+    points.emplace_back(std::numeric_limits<double>::quiet_NaN(), 0.0, 0.0);
+    points.emplace_back(0.0, std::numeric_limits<double>::infinity(), 0.0);
+    std::map<adit::VoxelKey, std::pair<Eigen::Vector3d, int>> reference;
+    for (const Eigen::Vector3d& p : points) {
+      if (!p.allFinite()) continue;
+      auto& cell = reference.try_emplace(adit::voxelOf(p, voxel), Eigen::Vector3d::Zero(), 0).first->second;
+      cell.first += p;
+      ++cell.second;
+    }
+    const std::vector<Eigen::Vector3d> thinned = adit::voxelDownsample(points, voxel);
+    ASSERT_EQ(thinned.size(), reference.size());
+    std::size_t i = 0;
+    for (const auto& [key, cell] : reference) {
+      const Eigen::Vector3d mean = cell.first / cell.second;
+      ASSERT_EQ(thinned[i].x(), mean.x()) << i;
+      ASSERT_EQ(thinned[i].y(), mean.y()) << i;
+      ASSERT_EQ(thinned[i].z(), mean.z()) << i;
+      ++i;
     }
   }
 }
