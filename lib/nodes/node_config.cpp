@@ -64,7 +64,7 @@ const ConfigTable<OdometryNodeConfig>& odometryNodeConfigTable() {
   static const ConfigTable<N> table = [] {
     ConfigTable<N> t("odometry.node");
     t.add("imu_keep_s", &N::imu_keep_s, above(0), "s", "IMU kept for the rotation seed between sweeps")
-     .add("forward_cloud_voxel", &N::forward_cloud_voxel, atLeast(0), "m", "voxel of the sweep forwarded on ODOM_SCAN (0 = as received)")
+     .add("forward_cloud_voxel", &N::forward_cloud_voxel, atLeast(0), "m", "voxel of the sweep forwarded on ODOM_SCAN (0 = as received, thinned by the feature stage)")
      .add("checkpoint_period_s", &N::checkpoint_period_s, atLeast(0), "s", "sensor time between pose checkpoints in live runs (0 = on stop only)")
      .add("max_extrapolation_s", &N::max_extrapolation_s, atLeast(0), "s", "longest gap the pose is carried across at the last velocity");
     return t;
