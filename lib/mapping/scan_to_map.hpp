@@ -18,7 +18,7 @@ namespace adit {
 
 class MatchReuse;  // registration/match_reuse.hpp
 
-class ChunkPool;  // registration/chunk_pool.hpp
+class ChunkPool;  // core/chunk_pool.hpp
 
 struct MapperConfig {
   RegistrationConfig registration;  // keys "mapping.<field>" (see registration.hpp)

@@ -20,7 +20,7 @@ namespace adit {
 
 class MatchReuse;  // registration/match_reuse.hpp
 
-class ChunkPool;  // registration/chunk_pool.hpp
+class ChunkPool;  // core/chunk_pool.hpp
 
 struct ScanToScanConfig {
   RegistrationConfig registration;  // keys "odometry.<field>" (see registration.hpp)

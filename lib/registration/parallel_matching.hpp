@@ -3,7 +3,7 @@
 // result is the one a single loop over the lines then the planes gives, bit for bit.
 #pragma once
 
-#include "registration/chunk_pool.hpp"
+#include "core/chunk_pool.hpp"
 #include "registration/correspondences.hpp"
 
 #include <algorithm>

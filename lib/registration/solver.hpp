@@ -56,7 +56,7 @@ struct RegistrationConfig {
   // Uncertainty of the motion model per sweep, used as the covariance of degenerate directions.
   double prior_sigma_translation_m = 0.1;
   double prior_sigma_rotation_rad = 0.01;
-  // Threads of the correspondence search (a fixed partition of the queries, chunk_pool.hpp): the result is
+  // Threads of the correspondence search (a fixed partition of the queries, core/chunk_pool.hpp): the result is
   // the same bytes for any count; 2 halves the search's wall time on a 2-core machine.
   int search_threads = 2;
   // A query that moved less than this since its last search in the same registration keeps that search's

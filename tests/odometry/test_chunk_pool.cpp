@@ -1,9 +1,9 @@
-// The correspondence search (registration/chunk_pool.*, parallel_matching.hpp, match_reuse.hpp): every query
+// The correspondence search (core/chunk_pool.*, registration/parallel_matching.hpp, match_reuse.hpp): every query
 // is searched once, an error in a chunk reaches the caller, odometry and mapping give the same bytes with one
 // thread or several, and a match is kept across rounds exactly while its query stays within the tolerance.
 #include "mapping/scan_to_map.hpp"
 #include "odometry/scan_to_scan.hpp"
-#include "registration/chunk_pool.hpp"
+#include "core/chunk_pool.hpp"
 #include "registration/match_reuse.hpp"
 #include "registration/parallel_matching.hpp"
 #include "synthetic_world.hpp"

@@ -1,6 +1,6 @@
-// A parallel loop whose results do not depend on scheduling, for correspondence search: [0, n) is cut into
-// `chunks` contiguous ranges by n and chunks alone; the caller and the worker threads take ranges until none
-// is left. A caller that writes each range's results into that range's own slot and joins the slots in range
+// A parallel loop whose results do not depend on scheduling (the registrations' correspondence search, the
+// feature stage): [0, n) is cut into `chunks` contiguous ranges by n and chunks alone; the caller and the
+// worker threads take ranges until none is left. A caller that writes each range's results into that range's own slot and joins the slots in range
 // order gets exactly the bytes one thread gives, whatever the thread count and whoever ran which range (so
 // replays stay byte-identical). On a busy machine a worker that gets no core costs at most the range it
 // holds: the caller takes every range the worker has not started.

@@ -1,4 +1,4 @@
-#include "registration/chunk_pool.hpp"
+#include "core/chunk_pool.hpp"
 
 #include <algorithm>
 
