@@ -14,8 +14,8 @@ namespace {
 // What a job decides with: its snapshot, the book and the configuration.
 class JobRun {
  public:
-  JobRun(const LoopJob& job, LoopBook& book, const LoopCloserConfig& config)
-      : job_(job), book_(book), config_(config) {}
+  JobRun(const LoopJob& job, LoopBook& book, const LoopCloserConfig& config, PlaneTargetCache* targets)
+      : job_(job), book_(book), config_(config), targets_(targets) {}
 
   LoopJobOutcome run() {
     LoopJobOutcome out;
@@ -168,7 +168,8 @@ class JobRun {
   // partial loop takes that axis from the graph). The clouds are decoded here, on the worker: the main thread
   // only copies the compact clouds into the job.
   std::vector<LoopVerification> verification(const LoopCandidateSnapshot& c, const std::vector<Eigen::Isometry3d>& seeds) {
-    const std::unique_ptr<PlaneTarget> target = candidateTarget(c.neighbourhood, config_.verifier);
+    const std::shared_ptr<const PlaneTarget> target =
+        targets_ ? targets_->target(c.neighbourhood, config_.verifier) : candidateTarget(c.neighbourhood, config_.verifier);
     const std::vector<Eigen::Vector3f>& source = querySourceOnce();
     const LoopVerification v = verifyLoopAgainst(*target, source, seeds, config_.verifier);
     const KeypointSeedConfig& k = config_.keypoints;
@@ -250,6 +251,7 @@ class JobRun {
   const LoopJob& job_;
   LoopBook& book_;
   const LoopCloserConfig& config_;
+  PlaneTargetCache* targets_;
   LoopCloserStats counts_;
   std::optional<std::vector<Eigen::Vector3f>> query_source_;  // querySourceOnce()
   std::optional<double> query_reach_;                          // innerQueryRadius of it, once needed
@@ -257,8 +259,9 @@ class JobRun {
 
 }  // namespace
 
-LoopJobOutcome runLoopJob(const LoopJob& job, LoopBook& book, const LoopCloserConfig& config) {
-  return JobRun(job, book, config).run();
+LoopJobOutcome runLoopJob(const LoopJob& job, LoopBook& book, const LoopCloserConfig& config,
+                          PlaneTargetCache* targets) {
+  return JobRun(job, book, config, targets).run();
 }
 
 LoopScheduler::LoopScheduler(const LoopCloserConfig& config, const LoopBook& book)
@@ -266,7 +269,7 @@ LoopScheduler::LoopScheduler(const LoopCloserConfig& config, const LoopBook& boo
 
 void LoopScheduler::submit(LoopJob job, std::int64_t due_utime) {
   auto task = std::make_shared<std::packaged_task<LoopJobOutcome()>>(
-      [this, job = std::move(job)] { return runLoopJob(job, book_, config_); });
+      [this, job = std::move(job)] { return runLoopJob(job, book_, config_, &targets_); });
   pending_.push_back({due_utime, task->get_future()});
   worker_.post([task] { (*task)(); });
 }

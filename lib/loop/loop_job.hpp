@@ -12,6 +12,7 @@
 
 #include "loop/loop_closer.hpp"
 #include "loop/place_match.hpp"
+#include "loop/plane_target_cache.hpp"
 #include "loop/serial_worker.hpp"
 
 #include <deque>
@@ -57,7 +58,9 @@ struct LoopJobOutcome {
   LoopCloserStats counts;                // queries, candidates, rejections, accepted, optimizations of this job
 };
 
-LoopJobOutcome runLoopJob(const LoopJob& job, LoopBook& book, const LoopCloserConfig& config);
+// `targets`: candidate submaps' ICP targets kept from earlier jobs (null: each built afresh; the same outcome).
+LoopJobOutcome runLoopJob(const LoopJob& job, LoopBook& book, const LoopCloserConfig& config,
+                          PlaneTargetCache* targets = nullptr);
 
 // Jobs in flight and when each is due. Wall time spent waiting for the worker is kept for STATUS only.
 class LoopScheduler {
@@ -78,6 +81,9 @@ class LoopScheduler {
   };
   LoopCloserConfig config_;
   LoopBook book_;  // only jobs use it, in the order posted
+  // Jobs only, too. Four targets (~1-2 MB each) catch most repeats: a candidate recurs over the next few
+  // keyframes while the robot passes the place it resembles.
+  PlaneTargetCache targets_{4};
   std::deque<Pending> pending_;
   double waited_ms_ = 0;
   SerialWorker worker_;  // declared last: stopped (its jobs finished) before book_ goes
