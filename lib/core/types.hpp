@@ -62,7 +62,7 @@ using LinK3dDescriptor = std::array<float, kLinK3dBins>;
 // Everything the feature stage extracts from one sweep (what odometry consumes).
 struct FeatureSet {
   std::int64_t utime = 0;
-  LidarScan cloud;  // preprocessed, deskewed full sweep (lidar frame at utime)
+  LidarScan cloud;  // preprocessed, deskewed sweep (lidar frame at utime), thinned when the extractor is asked to
   std::vector<LidarPoint> corner_sharp;
   std::vector<LidarPoint> corner_less_sharp;
   std::vector<LidarPoint> surf_flat;

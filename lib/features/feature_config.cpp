@@ -97,7 +97,9 @@ ConfigTable<R> ransacTable() {
 const ConfigTable<FeatureConfig>& featureConfigTable() {
   static const ConfigTable<FeatureConfig> table = [] {
     ConfigTable<FeatureConfig> t("features");
-    t.nest(&FeatureConfig::preprocess, preprocessTable())
+    t.add("threads", &FeatureConfig::threads, between(1, 64), "threads",
+          "threads of the feature stage (same result for any count)")
+     .nest(&FeatureConfig::preprocess, preprocessTable())
      .nest(&FeatureConfig::deskew, deskewTable())
      .nest(&FeatureConfig::loam, loamTable())
      .nest(&FeatureConfig::link3d, link3dTable())

@@ -191,6 +191,13 @@ struct FeatureConfig {
   LoamConfig loam;
   LinK3dConfig link3d;
   RansacConfig ransac;
+  // Threads of the stage (core/chunk_pool.hpp): rings scored in groups, then the LOAM selection, the LinK3D
+  // keypoints and the sweep's thinning side by side. The same FeatureSet for any count. The feature stage is
+  // the longest link of the chain every sweep waits for (feature stage -> odometry -> the next sweep's
+  // deskew); with a core to spare it ends sooner: simulated HDL-64 replay 11.6 -> 10.6 ms a scan. Where both
+  // cores are already busy (a VLP-16 replay, the mapper beside it) the wall time does not change, and the
+  // stage's own thread shows less CPU than it costs (2.8 -> 2.1 ms): measure the stages with 1.
+  int threads = 2;
 };
 
 // Keys "features.<group>.<field>" with type, range, unit and doc.

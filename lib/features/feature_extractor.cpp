@@ -1,5 +1,6 @@
 #include "features/feature_extractor.hpp"
 
+#include "core/chunk_pool.hpp"
 #include "features/link3d.hpp"
 #include "features/loam_features.hpp"
 #include "features/preprocess.hpp"
@@ -31,8 +32,11 @@ LidarScan cloudHeader(const LidarScan& scan) {
 
 }  // namespace
 
+FeatureExtractor::FeatureExtractor(FeatureConfig cfg)
+    : cfg_(std::move(cfg)), pool_(cfg_.threads > 1 ? std::make_shared<ChunkPool>(cfg_.threads) : nullptr) {}
+
 FeatureSet FeatureExtractor::process(const LidarScan& scan, const std::vector<ImuSample>& imu,
-                                     const MotionPrior& motion) const {
+                                     const MotionPrior& motion, float cloud_voxel) const {
   FeatureSet out;
   out.utime = scan.utime;
   out.cloud = cloudHeader(scan);
@@ -53,18 +57,30 @@ FeatureSet FeatureExtractor::process(const LidarScan& scan, const std::vector<Im
     out.cloud.deskewed = (out.flags & (FeatureSet::kDeskewImu | FeatureSet::kDeskewMotion)) != 0;
   }
 
-  const PointScores scores = scorePoints(rings, cfg_.loam);
-  LoamFeatures loam = selectLoamFeatures(rings, scores, cfg_.loam);
+  const PointScores scores = scorePoints(rings, cfg_.loam, pool_.get());
+  // Three independent jobs on the scored sweep, each writing only its own result: the LOAM sets, the LinK3D
+  // keypoints and descriptors, the thinned sweep (the first is the longest: the caller's thread takes it).
+  LoamFeatures loam;
+  std::vector<LidarPoint> thinned;
+  const auto job = [&](int chunk, std::size_t, std::size_t) {
+    if (chunk == 0) {
+      loam = selectLoamFeatures(rings, scores, cfg_.loam);
+    } else if (chunk == 1) {
+      for (const LinK3dCluster& c : extractLinK3dClusters(rings, scores, cfg_.link3d)) out.keypoints.push_back(c.centroid);
+      out.descriptors = computeLinK3dDescriptors(out.keypoints);
+    } else if (cloud_voxel > 0.0f) {
+      thinned = voxelDownsample(rings.points, cloud_voxel);
+    }
+  };
+  if (pool_) pool_->run(3, 3, job);
+  else for (int chunk = 0; chunk < 3; ++chunk) job(chunk, 0, 0);
   out.corner_sharp = std::move(loam.sharp);
   out.corner_less_sharp = std::move(loam.less_sharp);
   out.surf_flat = std::move(loam.flat);
   out.surf_less_flat = std::move(loam.less_flat);
-
-  for (const LinK3dCluster& c : extractLinK3dClusters(rings, scores, cfg_.link3d)) out.keypoints.push_back(c.centroid);
-  out.descriptors = computeLinK3dDescriptors(out.keypoints);
   if (static_cast<int>(out.keypoints.size()) < cfg_.link3d.min_keypoints) out.flags |= FeatureSet::kFewKeypoints;
 
-  out.cloud.points = std::move(rings.points);
+  out.cloud.points = cloud_voxel > 0.0f ? std::move(thinned) : std::move(rings.points);
   return out;
 }
 

@@ -5,25 +5,33 @@
 #include "features/deskew.hpp"
 #include "features/feature_config.hpp"
 
+#include <memory>
 #include <utility>
 #include <vector>
 
 namespace adit {
 
+class ChunkPool;  // core/chunk_pool.hpp
+
 class FeatureExtractor {
  public:
-  explicit FeatureExtractor(FeatureConfig cfg) : cfg_(std::move(cfg)) {}
+  explicit FeatureExtractor(FeatureConfig cfg);
 
   // preprocess -> deskew -> smoothness -> LOAM sets + LinK3D keypoints and descriptors.
   // imu: samples covering the sweep [utime - sweep_duration, utime] (may be empty);
   // motion: constant-velocity prior from odometry (valid = false if none).
+  // cloud_voxel > 0: FeatureSet::cloud is the deskewed sweep thinned to this voxel (centroids,
+  // features::voxelDownsample), what FEATURES carries for the maps; 0: the whole deskewed sweep.
   // Degenerate input (no points, empty rings, few keypoints) gives a valid FeatureSet with flags set.
-  FeatureSet process(const LidarScan& scan, const std::vector<ImuSample>& imu, const MotionPrior& motion) const;
+  // The same result for any features.threads; calls on one extractor from several threads take turns.
+  FeatureSet process(const LidarScan& scan, const std::vector<ImuSample>& imu, const MotionPrior& motion,
+                     float cloud_voxel = 0.0f) const;
 
   const FeatureConfig& config() const { return cfg_; }
 
  private:
   FeatureConfig cfg_;
+  std::shared_ptr<ChunkPool> pool_;  // features.threads > 1
 };
 
 }  // namespace adit

@@ -1,5 +1,7 @@
 #include "features/smoothness.hpp"
 
+#include "core/chunk_pool.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -130,26 +132,34 @@ void markUnreliable(int b, int e, const LoamConfig& cfg, PointScores& s) {
 
 }  // namespace
 
-PointScores scorePoints(const RingCloud& c, const LoamConfig& cfg) {
+PointScores scorePoints(const RingCloud& c, const LoamConfig& cfg, ChunkPool* pool) {
   const std::size_t n = c.points.size();
   PointScores s;
   s.range.resize(n);
   s.smoothness.assign(n, -1.0f);
   s.offset.assign(n, 0.0f);
   s.usable.assign(n, 1);
-  std::vector<float> second;
-  second.reserve(n);
-  RingPrefix prefix;
-  for (std::size_t i = 0; i < n; ++i) s.range[i] = c.points[i].p.norm();
-  for (int r = 0; r < c.numRings(); ++r) {
-    const int b = c.ring_begin[r], e = c.ring_begin[r + 1];
-    scoreRing(c, b, e, cfg, prefix, s);
-    collectSecondDifferences(c, b, e, cfg.noise_max_step, second);
-    markUnreliable(b, e, cfg, s);
-    for (int i = b; i < e; ++i)
-      if (s.smoothness[i] < 0.0f) s.usable[i] = 0;
-  }
-  s.noise = medianNoise(second);
+  // Each group of rings writes its own points' scores and its own second differences.
+  const int groups = pool ? std::min(pool->threads(), std::max(1, c.numRings())) : 1;
+  std::vector<std::vector<float>> second(static_cast<std::size_t>(groups));
+  const auto score = [&](int group, std::size_t ring_begin, std::size_t ring_end) {
+    std::vector<float>& out = second[static_cast<std::size_t>(group)];
+    RingPrefix prefix;
+    for (int r = static_cast<int>(ring_begin); r < static_cast<int>(ring_end); ++r) {
+      const int b = c.ring_begin[r], e = c.ring_begin[r + 1];
+      for (int i = b; i < e; ++i) s.range[i] = c.points[i].p.norm();
+      scoreRing(c, b, e, cfg, prefix, s);
+      collectSecondDifferences(c, b, e, cfg.noise_max_step, out);
+      markUnreliable(b, e, cfg, s);
+      for (int i = b; i < e; ++i)
+        if (s.smoothness[i] < 0.0f) s.usable[i] = 0;
+    }
+  };
+  if (pool && groups > 1) pool->run(static_cast<std::size_t>(c.numRings()), groups, score);
+  else score(0, 0, static_cast<std::size_t>(c.numRings()));
+  // The median does not depend on the order the groups' differences are joined in.
+  for (std::size_t g = 1; g < second.size(); ++g) second[0].insert(second[0].end(), second[g].begin(), second[g].end());
+  s.noise = medianNoise(second[0]);
   return s;
 }
 

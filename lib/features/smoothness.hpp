@@ -7,6 +7,10 @@
 #include <cstdint>
 #include <vector>
 
+namespace adit {
+class ChunkPool;  // core/chunk_pool.hpp
+}
+
 namespace adit::features {
 
 struct PointScores {
@@ -35,6 +39,8 @@ struct PointScores {
   std::vector<std::uint8_t> usable;
 };
 
-PointScores scorePoints(const RingCloud& cloud, const LoamConfig& cfg);
+// Rings are scored independently: with a pool, groups of rings on its threads (the same scores and the same
+// noise figure, a median, for any thread count).
+PointScores scorePoints(const RingCloud& cloud, const LoamConfig& cfg, ChunkPool* pool = nullptr);
 
 }  // namespace adit::features

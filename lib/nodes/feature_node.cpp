@@ -1,7 +1,6 @@
 #include "nodes/feature_node.hpp"
 
 #include "features/feature_extractor.hpp"
-#include "features/preprocess.hpp"
 #include "msg/convert.hpp"
 #include "msg/sweep_codec.hpp"
 #include "nodes/sample_buffer.hpp"
@@ -99,7 +98,7 @@ class FeatureNode : public runtime::Node {
     std::vector<ImuSample> imu = imu_.samples();
     // Only what was measured up to the sweep's end: later samples may or may not have arrived yet.
     while (!imu.empty() && imu.back().utime > scan.utime) imu.pop_back();
-    FeatureSet features = extractor_.process(scan, imu, motionPrior(scan.utime));
+    FeatureSet features = extractor_.process(scan, imu, motionPrior(scan.utime), static_cast<float>(map_cloud_voxel_));
     sweeps_.push_back(scan.utime);
     if (sweeps_.size() > 2) sweeps_.pop_front();
     count("points_in", features.points_in);
@@ -108,8 +107,6 @@ class FeatureNode : public runtime::Node {
     count("removed_outlier", features.removed_outlier);
     if (features.flags & FeatureSet::kFewKeypoints) count("few_keypoints");
     if (features.flags & FeatureSet::kEmptyRing) count("empty_ring");
-    if (map_cloud_voxel_ > 0)
-      features.cloud.points = features::voxelDownsample(features.cloud.points, static_cast<float>(map_cloud_voxel_));
     adit::features_t out = msg::toMessage(features);
     publish("features", out);
   }

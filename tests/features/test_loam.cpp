@@ -192,5 +192,58 @@ TEST(LoamFeatures, SectorCapsAndSuppressionLimitCounts) {
       }
 }
 
+// features.threads only spreads the work: every set, keypoint, descriptor, flag and the thinned sweep are the
+// same bytes for one thread or several (the rings' noise figure is a median, independent of how the rings
+// are grouped), on a moving noisy sweep of the pillar hall, deskewed and not.
+TEST(FeatureExtractor, TheSameFeaturesForAnyThreadCount) {
+  LidarScan scan = test::scanScene(test::pillarHall(), [](double t) {
+    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+    T.translation() = Eigen::Vector3d(1.5 * t, 0.2 * t, 0.0);
+    return T;
+  });
+  std::mt19937 rng(7);
+  std::normal_distribution<float> noise(0.0f, 0.01f);
+  for (LidarPoint& p : scan.points) p.p *= 1.0f + noise(rng) / p.p.norm();
+  MotionPrior prior;
+  prior.T_prev_curr.translation() = Eigen::Vector3d(0.15, 0.02, 0.0);
+  prior.dt_s = 0.1;
+  prior.valid = true;
+  const auto bytes = [](const std::vector<LidarPoint>& v) {
+    std::vector<float> out;
+    for (const LidarPoint& p : v) out.insert(out.end(), {p.p.x(), p.p.y(), p.p.z(), p.intensity, p.dt, float(p.ring)});
+    return out;
+  };
+  for (const float voxel : {0.0f, 0.1f}) {
+    FeatureConfig one;
+    one.threads = 1;
+    const FeatureSet a = FeatureExtractor(one).process(scan, {}, prior, voxel);
+    ASSERT_GT(a.corner_sharp.size(), 0u);
+    ASSERT_GT(a.keypoints.size(), 0u);
+    for (const int threads : {2, 3, 16}) {
+      FeatureConfig many;
+      many.threads = threads;
+      const FeatureExtractor extractor(many);
+      for (int repeat = 0; repeat < 3; ++repeat) {
+        const FeatureSet b = extractor.process(scan, {}, prior, voxel);
+        EXPECT_EQ(bytes(a.corner_sharp), bytes(b.corner_sharp)) << threads;
+        EXPECT_EQ(bytes(a.corner_less_sharp), bytes(b.corner_less_sharp)) << threads;
+        EXPECT_EQ(bytes(a.surf_flat), bytes(b.surf_flat)) << threads;
+        EXPECT_EQ(bytes(a.surf_less_flat), bytes(b.surf_less_flat)) << threads;
+        EXPECT_EQ(bytes(a.cloud.points), bytes(b.cloud.points)) << threads;
+        ASSERT_EQ(a.keypoints.size(), b.keypoints.size());
+        for (std::size_t i = 0; i < a.keypoints.size(); ++i) EXPECT_EQ(a.keypoints[i], b.keypoints[i]);
+        EXPECT_EQ(a.descriptors, b.descriptors);
+        EXPECT_EQ(a.flags, b.flags);
+      }
+    }
+    // The thinned sweep is features::voxelDownsample of the whole one.
+    if (voxel > 0.0f) {
+      const FeatureSet whole = FeatureExtractor(one).process(scan, {}, prior, 0.0f);
+      EXPECT_EQ(bytes(a.cloud.points), bytes(features::voxelDownsample(whole.cloud.points, voxel)));
+      EXPECT_LT(a.cloud.points.size(), whole.cloud.points.size());
+    }
+  }
+}
+
 }  // namespace
 }  // namespace adit
