@@ -285,6 +285,7 @@ std::vector<LoopJobOutcome> LoopScheduler::take(std::int64_t utime, bool all) {
     due.push_back(f.get());
     pending_.pop_front();
   }
+  if (all) targets_.clear();  // no job in flight: the worker does not touch it now
   return due;
 }
 

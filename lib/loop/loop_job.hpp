@@ -67,7 +67,9 @@ class LoopScheduler {
  public:
   explicit LoopScheduler(const LoopCloserConfig& config, const LoopBook& book = {});
   void submit(LoopJob job, std::int64_t due_utime);
-  // Outcomes due at `utime` (all of them when `all`), oldest first; waits for those not finished.
+  // Outcomes due at `utime` (all of them when `all`), oldest first; waits for those not finished. With
+  // `all` (the run's end, or keyframes about to be merged) the kept ICP targets are dropped too: no job is
+  // left to use them, and the corrected map is built next at the end of a run.
   std::vector<LoopJobOutcome> take(std::int64_t utime, bool all = false);
   std::size_t inFlight() const { return pending_.size(); }
   // With no job in flight (after take(all)): the book renumbered by the loop closer (keyframes merged out).

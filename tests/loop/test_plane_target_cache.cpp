@@ -62,6 +62,9 @@ TEST(PlaneTargetCache, EvictsTheLeastRecentlyUsed) {
   EXPECT_EQ(cache.builds(), 3u);
   cache.target(b, config);
   EXPECT_EQ(cache.builds(), 4u);
+  cache.clear();
+  cache.target(b, config);
+  EXPECT_EQ(cache.builds(), 5u);
   PlaneTargetCache none(0);
   none.target(a, config);
   none.target(a, config);
