@@ -43,17 +43,23 @@ std::vector<Eigen::Vector3f> centroidsOfSorted(const std::vector<Eigen::Vector3f
 // Voxel indices within +-2^20 (+-262 km at 0.25 m) packed into one integer that orders like the key (x, y, z):
 // half the bytes to sort and one comparison instead of three. False if a point is beyond that.
 constexpr long long kPackedHalfRange = 1LL << 20;
+bool packedKey(const Key& k, std::uint64_t& code) {
+  code = 0;
+  for (const long long v : k) {
+    if (v < -kPackedHalfRange || v >= kPackedHalfRange) return false;
+    code = (code << 21) | static_cast<std::uint64_t>(v + kPackedHalfRange);
+  }
+  return true;
+}
+
 bool packAll(const std::vector<Eigen::Vector3f>& points, double voxel,
              std::vector<std::pair<std::uint64_t, int>>& packed) {
   packed.reserve(points.size());
   for (std::size_t i = 0; i < points.size(); ++i) {
     Key k;
-    if (!voxelKeyOf(points[i], voxel, k)) continue;
     std::uint64_t code = 0;
-    for (const long long v : k) {
-      if (v < -kPackedHalfRange || v >= kPackedHalfRange) return false;
-      code = (code << 21) | static_cast<std::uint64_t>(v + kPackedHalfRange);
-    }
+    if (!voxelKeyOf(points[i], voxel, k)) continue;
+    if (!packedKey(k, code)) return false;
     packed.emplace_back(code, static_cast<int>(i));
   }
   return true;
@@ -80,28 +86,77 @@ std::vector<Eigen::Vector3f> voxelDownsample(const std::vector<Eigen::Vector3f>&
   return centroidsOfSorted(points, keyed);
 }
 
-std::size_t VoxelAccumulator::KeyHash::operator()(const Key& k) const {
-  std::size_t h = 1469598103934665603ull;
-  for (long long v : k) h = (h ^ static_cast<std::size_t>(v)) * 1099511628211ull;
-  return h;
+namespace {
+
+std::size_t hashOf(const std::array<long long, 3>& k) {
+  std::uint64_t h = 1469598103934665603ull;
+  for (long long v : k) h = (h ^ static_cast<std::uint64_t>(v)) * 1099511628211ull;
+  h ^= h >> 29;  // FNV's low bits, which pick the slot, mixed with its high ones
+  h *= 0xbf58476d1ce4e5b9ull;
+  return static_cast<std::size_t>(h ^ (h >> 32));
+}
+
+}  // namespace
+
+VoxelAccumulator::VoxelAccumulator(double voxel) : voxel_(voxel), table_(1024, -1) {}
+
+std::size_t VoxelAccumulator::slotOf(const Key& key) const {
+  const std::size_t mask = table_.size() - 1;
+  std::size_t slot = hashOf(key) & mask;
+  while (table_[slot] >= 0 && cells_[static_cast<std::size_t>(table_[slot])].key != key) slot = (slot + 1) & mask;
+  return slot;
+}
+
+void VoxelAccumulator::grow() {
+  table_.assign(table_.size() * 2, -1);
+  for (std::size_t i = 0; i < cells_.size(); ++i) table_[slotOf(cells_[i].key)] = static_cast<std::int32_t>(i);
 }
 
 void VoxelAccumulator::add(const Eigen::Vector3f& p) {
   Key k;
   if (!voxelKeyOf(p, voxel_, k)) return;
-  Sum& s = cells_[k];
-  s.sum += p.cast<double>();
-  ++s.count;
+  std::size_t slot = slotOf(k);
+  if (table_[slot] < 0) {
+    if (2 * (cells_.size() + 1) > table_.size()) {
+      grow();
+      slot = slotOf(k);
+    }
+    table_[slot] = static_cast<std::int32_t>(cells_.size());
+    cells_.push_back({k});
+  }
+  Cell& c = cells_[static_cast<std::size_t>(table_[slot])];
+  c.sum += p.cast<double>();
+  ++c.count;
 }
 
 std::vector<Eigen::Vector3f> VoxelAccumulator::centroids() const {
-  std::vector<std::pair<Key, const Sum*>> sorted;
-  sorted.reserve(cells_.size());
-  for (const auto& kv : cells_) sorted.emplace_back(kv.first, &kv.second);
-  std::sort(sorted.begin(), sorted.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+  // Voxel order: the packed key (x, y, z in 21 bits each, which orders like the key) when every voxel has
+  // one, else the keys compared through the cells' indices. Keys are unique: the order is the same either way.
+  std::vector<std::pair<std::uint64_t, std::uint32_t>> packed;
+  packed.reserve(cells_.size());
+  for (std::size_t i = 0; i < cells_.size(); ++i) {
+    std::uint64_t code = 0;
+    if (!packedKey(cells_[i].key, code)) {
+      packed = {};
+      break;
+    }
+    packed.emplace_back(code, static_cast<std::uint32_t>(i));
+  }
   std::vector<Eigen::Vector3f> out;
-  out.reserve(sorted.size());
-  for (const auto& [key, s] : sorted) out.push_back((s->sum / static_cast<double>(s->count)).cast<float>());
+  out.reserve(cells_.size());
+  const auto centroid = [this, &out](std::uint32_t i) {
+    const Cell& c = cells_[i];
+    out.push_back((c.sum / static_cast<double>(c.count)).cast<float>());
+  };
+  if (packed.size() == cells_.size()) {
+    std::sort(packed.begin(), packed.end());
+    for (const auto& [code, i] : packed) centroid(i);
+    return out;
+  }
+  std::vector<std::uint32_t> order(cells_.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = static_cast<std::uint32_t>(i);
+  std::sort(order.begin(), order.end(), [this](std::uint32_t a, std::uint32_t b) { return cells_[a].key < cells_[b].key; });
+  for (const std::uint32_t i : order) centroid(i);
   return out;
 }
 

@@ -543,9 +543,12 @@ TEST(VoxelDownsample, PackedAndWideKeysGiveTheSameCentroids) {
   wide.pop_back();
   EXPECT_EQ(wide, packed);
   EXPECT_LT(packed.size(), near.size() * 3 / 4);  // voxels were shared: the sums and their order were exercised
-  VoxelAccumulator grid(0.25);  // the accumulator (three-integer keys) agrees too
+  VoxelAccumulator grid(0.25);  // the accumulator agrees too, with packed keys and without
   for (const Eigen::Vector3f& p : near) grid.add(p);
   EXPECT_EQ(grid.centroids(), packed);
+  grid.add(with_far.back());
+  wide.push_back(with_far.back());
+  EXPECT_EQ(grid.centroids(), wide);
 }
 
 }  // namespace
