@@ -174,6 +174,7 @@ void LoopCloser::applyDue(std::int64_t utime, bool all, Result& result) {
     stats_.partial_loops += c.partial_loops;
     stats_.keypoint_seeds += c.keypoint_seeds;
     stats_.keypoint_loops += c.keypoint_loops;
+    stats_.submaps_reused += c.submaps_reused;
     stats_.rejected_ambiguous += c.rejected_ambiguous;
     stats_.optimizations += c.optimizations;
     stats_.pending = c.pending;

@@ -165,6 +165,8 @@ struct LoopCloserStats {
   int rejected_ambiguous = 0;   // two accepted fits in different places, both within the odometry gate
   int contested = 0;            // enough loops agreed but waited: as many waiting loops contradicted them
   int retired_keyframes = 0;    // merged out of the graph (retire_after_keyframes)
+  int submaps_reused = 0;       // candidates verified against a submap target kept from an earlier job (not
+                                // checkpointed either)
 };
 
 class LoopScheduler;

@@ -168,8 +168,10 @@ class JobRun {
   // partial loop takes that axis from the graph). The clouds are decoded here, on the worker: the main thread
   // only copies the compact clouds into the job.
   std::vector<LoopVerification> verification(const LoopCandidateSnapshot& c, const std::vector<Eigen::Isometry3d>& seeds) {
+    const std::size_t reused = targets_ ? targets_->hits() : 0;
     const std::shared_ptr<const PlaneTarget> target =
         targets_ ? targets_->target(c.neighbourhood, config_.verifier) : candidateTarget(c.neighbourhood, config_.verifier);
+    if (targets_ && targets_->hits() > reused) ++counts_.submaps_reused;
     const std::vector<Eigen::Vector3f>& source = querySourceOnce();
     const LoopVerification v = verifyLoopAgainst(*target, source, seeds, config_.verifier);
     const KeypointSeedConfig& k = config_.keypoints;

@@ -171,6 +171,7 @@ class LoopCloserNode : public runtime::Node, public WritesProducts, public Write
     setCount("loops_accepted", s.accepted);
     setCount("partial_loops", s.partial_loops);
     setCount("keypoint_seeds", s.keypoint_seeds);
+    setCount("submaps_reused", s.submaps_reused);
     setCount("keypoint_loops", s.keypoint_loops);
     setCount("rejected_ambiguous", s.rejected_ambiguous);
     setCount("contested", s.contested);

@@ -162,6 +162,29 @@ TEST(KeypointSeed, FindsARevisitMetresToTheSideFromLinK3dKeypoints) {
   EXPECT_FALSE(none.ok);
 }
 
+// Loop jobs with the scheduler's cache of submap targets: the same outcome as without it; the second job on
+// the same candidate neighbourhood verifies against the kept target and says so (STATUS submaps_reused).
+TEST(KeypointSeed, AJobOnAKeptSubmapTargetDecidesAsWithoutIt) {
+  const BoxWorld world = adit::testing::makeRoadway(11, 8.0, 24);
+  const Eigen::Isometry3d match = poseXYYaw(0, 0, 1.8, 0);
+  const Eigen::Isometry3d query = poseXYYaw(0.6, 1.8, 1.8, 25 * kDeg);
+  const LoopJob job = jobWithBadSeeds(match, query, sweepAt(world, query, 7), neighbourhoodAt(world, match, 5),
+                                      poseXYYaw(-3.0, 2.6, 0, -40 * kDeg));
+  LoopBook plain_book;
+  const LoopJobOutcome plain = runLoopJob(job, plain_book, jobConfig(true));
+  ASSERT_EQ(plain.loops.size(), 1u);
+  PlaneTargetCache cache(4);
+  for (int run = 0; run < 2; ++run) {
+    LoopBook book;
+    const LoopJobOutcome cached = runLoopJob(job, book, jobConfig(true), &cache);
+    EXPECT_EQ(cached.counts.submaps_reused, run);
+    ASSERT_EQ(cached.loops.size(), 1u);
+    EXPECT_TRUE(cached.loops[0].T_match_query.isApprox(plain.loops[0].T_match_query, 0.0));
+    EXPECT_EQ(cached.loops[0].fitness, plain.loops[0].fitness);
+  }
+  EXPECT_EQ(cache.builds(), 1u);
+}
+
 TEST(KeypointSeed, FindsTheLoopWhereScanContextAndGraphSeedsDoNotFit) {
   const BoxWorld world = adit::testing::makeRoadway(11, 8.0, 24);
   const Eigen::Isometry3d match = poseXYYaw(0, 0, 1.8, 0);
