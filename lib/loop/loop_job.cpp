@@ -15,7 +15,7 @@ namespace {
 class JobRun {
  public:
   JobRun(const LoopJob& job, LoopBook& book, const LoopCloserConfig& config, PlaneTargetCache* targets)
-      : job_(job), book_(book), config_(config), targets_(targets) {}
+      : job_(job), book_(book), config_(config), targets_(targets ? targets : &unkept_) {}
 
   LoopJobOutcome run() {
     LoopJobOutcome out;
@@ -168,10 +168,9 @@ class JobRun {
   // partial loop takes that axis from the graph). The clouds are decoded here, on the worker: the main thread
   // only copies the compact clouds into the job.
   std::vector<LoopVerification> verification(const LoopCandidateSnapshot& c, const std::vector<Eigen::Isometry3d>& seeds) {
-    const std::size_t reused = targets_ ? targets_->hits() : 0;
-    const std::shared_ptr<const PlaneTarget> target =
-        targets_ ? targets_->target(c.neighbourhood, config_.verifier) : candidateTarget(c.neighbourhood, config_.verifier);
-    if (targets_ && targets_->hits() > reused) ++counts_.submaps_reused;
+    bool kept = false;
+    const std::shared_ptr<const PlaneTarget> target = targets_->target(c.neighbourhood, config_.verifier, &kept);
+    if (kept) ++counts_.submaps_reused;
     const std::vector<Eigen::Vector3f>& source = querySourceOnce();
     const LoopVerification v = verifyLoopAgainst(*target, source, seeds, config_.verifier);
     const KeypointSeedConfig& k = config_.keypoints;
@@ -253,6 +252,7 @@ class JobRun {
   const LoopJob& job_;
   LoopBook& book_;
   const LoopCloserConfig& config_;
+  PlaneTargetCache unkept_{0};  // no cache given: every target built afresh
   PlaneTargetCache* targets_;
   LoopCloserStats counts_;
   std::optional<std::vector<Eigen::Vector3f>> query_source_;  // querySourceOnce()

@@ -18,16 +18,18 @@ bool sameNeighbourhood(const CandidateNeighbourhood& a, const CandidateNeighbour
 }
 
 std::shared_ptr<const PlaneTarget> PlaneTargetCache::target(const CandidateNeighbourhood& neighbourhood,
-                                                            const LoopVerifierConfig& config) {
+                                                            const LoopVerifierConfig& config, bool* kept) {
   for (auto it = entries_.begin(); it != entries_.end(); ++it) {
     if (!sameNeighbourhood(it->neighbourhood, neighbourhood)) continue;
     ++hits_;
+    if (kept) *kept = true;
     Entry entry = std::move(*it);
     entries_.erase(it);
     entries_.push_front(std::move(entry));
     return entries_.front().target;
   }
   ++builds_;
+  if (kept) *kept = false;
   std::shared_ptr<const PlaneTarget> built = candidateTarget(neighbourhood, config);
   if (capacity_ == 0) return built;
   entries_.push_front({neighbourhood, built});

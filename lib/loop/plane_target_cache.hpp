@@ -21,8 +21,9 @@ class PlaneTargetCache {
   explicit PlaneTargetCache(std::size_t capacity = 4) : capacity_(capacity) {}
 
   // The target of this neighbourhood's submap (candidateTarget), built, or kept from an earlier call with an
-  // equal neighbourhood (one cache serves one verifier configuration).
-  std::shared_ptr<const PlaneTarget> target(const CandidateNeighbourhood& neighbourhood, const LoopVerifierConfig& config);
+  // equal neighbourhood (one cache serves one verifier configuration); `kept` (if given) says which.
+  std::shared_ptr<const PlaneTarget> target(const CandidateNeighbourhood& neighbourhood, const LoopVerifierConfig& config,
+                                            bool* kept = nullptr);
 
   void clear() { entries_.clear(); }  // frees the targets (~1-2 MB each)
   std::size_t hits() const { return hits_; }
