@@ -68,12 +68,13 @@ FeatureSet FeatureExtractor::process(const LidarScan& scan, const std::vector<Im
     } else if (chunk == 1) {
       for (const LinK3dCluster& c : extractLinK3dClusters(rings, scores, cfg_.link3d)) out.keypoints.push_back(c.centroid);
       out.descriptors = computeLinK3dDescriptors(out.keypoints);
-    } else if (cloud_voxel > 0.0f) {
+    } else {
       thinned = voxelDownsample(rings.points, cloud_voxel);
     }
   };
-  if (pool_) pool_->run(3, 3, job);
-  else for (int chunk = 0; chunk < 3; ++chunk) job(chunk, 0, 0);
+  const int jobs = cloud_voxel > 0.0f ? 3 : 2;
+  if (pool_) pool_->run(static_cast<std::size_t>(jobs), jobs, job);
+  else for (int chunk = 0; chunk < jobs; ++chunk) job(chunk, 0, 0);
   out.corner_sharp = std::move(loam.sharp);
   out.corner_less_sharp = std::move(loam.less_sharp);
   out.surf_flat = std::move(loam.flat);
