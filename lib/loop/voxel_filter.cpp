@@ -1,5 +1,7 @@
 #include "loop/voxel_filter.hpp"
 
+#include "core/hash_mix.hpp"
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -88,12 +90,11 @@ std::vector<Eigen::Vector3f> voxelDownsample(const std::vector<Eigen::Vector3f>&
 
 namespace {
 
+// FNV-1a over the three indices, its high bits mixed into the low ones that pick the slot.
 std::size_t hashOf(const std::array<long long, 3>& k) {
   std::uint64_t h = 1469598103934665603ull;
   for (long long v : k) h = (h ^ static_cast<std::uint64_t>(v)) * 1099511628211ull;
-  h ^= h >> 29;  // FNV's low bits, which pick the slot, mixed with its high ones
-  h *= 0xbf58476d1ce4e5b9ull;
-  return static_cast<std::size_t>(h ^ (h >> 32));
+  return static_cast<std::size_t>(mixHashBits(h));
 }
 
 }  // namespace

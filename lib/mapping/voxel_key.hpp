@@ -1,6 +1,8 @@
 // Integer voxel coordinates and their hash, shared by the local and global maps.
 #pragma once
 
+#include "core/hash_mix.hpp"
+
 #include <Eigen/Core>
 
 #include <cmath>
@@ -27,13 +29,7 @@ struct VoxelKeyHash {
 
 // The spatial hash mixed so that its low bits, which pick a slot of an open-addressing table, depend on
 // every bit of the key.
-inline std::size_t mixedVoxelHash(const VoxelKey& key) {
-  std::uint64_t h = VoxelKeyHash{}(key);
-  h ^= h >> 31;
-  h *= 0xbf58476d1ce4e5b9ULL;
-  h ^= h >> 29;
-  return static_cast<std::size_t>(h);
-}
+inline std::size_t mixedVoxelHash(const VoxelKey& key) { return static_cast<std::size_t>(mixHashBits(VoxelKeyHash{}(key))); }
 
 // Voxel index of one coordinate, clamped so that the cast cannot overflow (a tiny voxel or a far point; a
 // NaN lands in voxel 0) and a neighbour index (+-1) still fits in 32 bits.
