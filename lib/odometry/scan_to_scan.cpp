@@ -83,6 +83,7 @@ const ConfigTable<ScanToScanConfig>& scanToScanConfigTable() {
      .add("startup_max_speed_mps", &S::startup_max_speed_mps, atLeast(0), "m/s", "fastest a vehicle may already move when odometry starts (start-up search range; 0 = no search)")
      .add("startup_search_step_m", &S::startup_search_step_m, above(0), "m", "spacing of the start-up search's seeds along the forward axis")
      .add("startup_inlier_distance_m", &S::startup_inlier_distance_m, above(0), "m", "residual below which a correspondence counts for a start-up seed")
+     .add("startup_screen_points", &S::startup_screen_points, between(0, 1000000), "points", "sharp and flat points each start-up seed is refined and scored on (every k-th of the sweep's; 0 = all)")
      .add("keep_reference_within_m", &S::keep_reference_within_m, atLeast(0), "m", "a sweep this close to the reference sweep leaves it the registration target (at rest errors do not add up; 0 = always the previous sweep)")
      .add("keep_reference_within_rad", &S::keep_reference_within_rad, atLeast(0), "rad", "and turned less than this from it (0 = always the previous sweep)");
     return t;
@@ -285,16 +286,31 @@ ScanToScanOdometry::Refinement ScanToScanOdometry::searchStart(const SweepPoints
                                                                const Eigen::Isometry3d& hold, bool can_hold,
                                                                double gap_s, const RotationPrior* gyro) const {
   const double reach = config_.startup_max_speed_mps * std::max(0.0, gap_s);
+  const std::vector<Eigen::Isometry3d> hypotheses = startupHypotheses(seed, reach, config_.startup_search_step_m);
+  // Every seed is refined and scored on a screen of the sweep's sharp and flat points (every stride-th).
+  const std::size_t stride =
+      screenStride(cur.sharp.size() + cur.flat.size(), config_.startup_screen_points);
+  SweepPoints thinned;
+  if (stride > 1) {
+    for (std::size_t i = 0; i < cur.sharp.size(); i += stride) thinned.sharp.push_back(cur.sharp[i]);
+    for (std::size_t i = 0; i < cur.flat.size(); i += stride) thinned.flat.push_back(cur.flat[i]);
+  }
+  const SweepPoints& screen = stride > 1 ? thinned : cur;
   Refinement best;
   best.pose = seed;
   int best_inliers = -1;
-  const std::vector<Eigen::Isometry3d> hypotheses = startupHypotheses(seed, reach, config_.startup_search_step_m);
   for (std::size_t i = 0; i < hypotheses.size(); ++i) {
-    Refinement r = refine(cur, hypotheses[i], hold, can_hold, gyro);
+    Refinement r = refine(screen, hypotheses[i], hold, can_hold, gyro);
     if (!r.ok) continue;
-    const int inliers = inlierCount(match(cur.sharp, cur.flat, r.pose), r.pose, config_.startup_inlier_distance_m);
+    const int inliers = inlierCount(match(screen.sharp, screen.flat, r.pose), r.pose, config_.startup_inlier_distance_m);
     r.from_prior = i == 0;
     if (inliers > best_inliers) best = r, best_inliers = inliers;
+  }
+  // The winner refined on the whole sweep: the prior from itself, exactly as without the search.
+  if (stride > 1 && best.ok) {
+    const bool from_prior = best.from_prior;
+    best = refine(cur, from_prior ? hypotheses.front() : best.pose, hold, can_hold, gyro);
+    best.from_prior = from_prior;
   }
   return best;
 }

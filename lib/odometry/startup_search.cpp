@@ -1,5 +1,6 @@
 #include "odometry/startup_search.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 namespace adit {
@@ -21,6 +22,12 @@ std::vector<Eigen::Isometry3d> startupHypotheses(const Eigen::Isometry3d& prior,
     }
   }
   return out;
+}
+
+std::size_t screenStride(std::size_t points, int screen_points) {
+  if (screen_points <= 0) return 1;
+  const auto wanted = static_cast<std::size_t>(screen_points);
+  return std::max<std::size_t>(1, points / wanted);
 }
 
 int inlierCount(const Correspondences& matches, const Eigen::Isometry3d& T, double max_residual_m) {
