@@ -47,6 +47,7 @@ const ConfigTable<MapperConfig>& mapperConfigTable() {
      .add("outer_iterations", &M::outer_iterations, between(1, 100), "", "correspondence rounds per sweep (A-LOAM: 2)")
      .add("corner_resolution_m", &M::corner_resolution_m, between(0.01, 10), "m", "resolution of edge points in the sweep and the map")
      .add("surf_resolution_m", &M::surf_resolution_m, between(0.01, 10), "m", "resolution of surface points in the sweep and the map")
+     .add("surf_query_resolution_m", &M::surf_query_resolution_m, between(0, 10), "m", "coarser resolution of the surface points a sweep registers with (0: surf_resolution_m)")
      .add("map_voxel_size_m", &M::map_voxel_size_m, between(0.05, 100), "m", "local-map voxel edge, also the largest exact neighbour-search radius")
      .add("max_points_per_voxel", &M::max_points_per_voxel, between(1, 100000), "points", "density bound of a local-map voxel")
      .add("neighbours", &M::neighbours, between(3, 100), "points", "neighbours per feature (A-LOAM: 5)")
@@ -125,6 +126,9 @@ ScanToMapMapper::Sweep ScanToMapMapper::prepare(const FeatureSet& f) const {
 void ScanToMapMapper::downsample(Sweep& s) const {
   s.corner_points = voxelDownsample(toDouble(s.corners), config_.corner_resolution_m);
   s.surf_points = voxelDownsample(toDouble(s.surfs), config_.surf_resolution_m);
+  s.surf_queries = config_.surf_query_resolution_m > config_.surf_resolution_m
+                       ? voxelDownsample(s.surf_points, config_.surf_query_resolution_m)
+                       : s.surf_points;
 }
 
 void ScanToMapMapper::compensate(Sweep& s, const Eigen::Isometry3d& T_prev_curr, double gap_s) const {
@@ -149,9 +153,9 @@ ScanToMapMapper::Refinement ScanToMapMapper::refine(const Sweep& sweep, const Ei
                                                      int& iterations) const {
   Refinement out;
   out.pose = predicted;
-  MatchReuse reuse(sweep.corner_points.size(), sweep.surf_points.size(), config_.registration.reuse_match_distance_m);
+  MatchReuse reuse(sweep.corner_points.size(), sweep.surf_queries.size(), config_.registration.reuse_match_distance_m);
   for (int round = 0; round < std::max(1, config_.outer_iterations); ++round) {
-    out.result = registerStep(match(sweep.corner_points, sweep.surf_points, out.pose, &reuse), out.pose, predicted,
+    out.result = registerStep(match(sweep.corner_points, sweep.surf_queries, out.pose, &reuse), out.pose, predicted,
                               config_.registration);
     iterations += out.result.iterations;
     if (!(out.ok = out.result.ok)) break;

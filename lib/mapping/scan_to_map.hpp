@@ -28,6 +28,10 @@ struct MapperConfig {
   // 0.4 / 0.8 suit 64-beam data.
   double corner_resolution_m = 0.2;
   double surf_resolution_m = 0.4;
+  // Resolution of the surface points a sweep registers with, where coarser than surf_resolution_m (0: that).
+  // The map keeps its density for the plane fits while the queries thin: a 64-beam sweep has ~15k surface
+  // points at 0.4 m, ~6k at 0.8 m (launch/sensors/hdl64.yaml: 0.8, A-LOAM's 64-beam surface resolution).
+  double surf_query_resolution_m = 0.0;
   // Local-map voxel edge (m). Neighbour search looks at the 27 voxels around a point, so this is also the
   // largest neighbour distance that is searched exactly.
   double map_voxel_size_m = 1.0;
@@ -129,7 +133,8 @@ class ScanToMapMapper {
     std::int64_t utime = 0;
     bool raw = false;
     std::vector<LidarPoint> corners, surfs, cloud;
-    std::vector<Eigen::Vector3d> corner_points, surf_points;  // downsampled corners / surfs
+    std::vector<Eigen::Vector3d> corner_points, surf_points;  // downsampled corners / surfs (into the maps)
+    std::vector<Eigen::Vector3d> surf_queries;  // surf_points at surf_query_resolution_m (registered)
   };
   struct Refinement {
     bool ok = false;

@@ -55,7 +55,7 @@ const Sequence& kitti02() {
       odom.process(q.features.back());
     }
     q.mapper.corner_resolution_m = 0.4;
-    q.mapper.surf_resolution_m = 0.8;
+    q.mapper.surf_query_resolution_m = 0.8;  // the map keeps 0.4 m (launch/sensors/hdl64.yaml)
     computeOdometry(q);
     return q;
   }();
