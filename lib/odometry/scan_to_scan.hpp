@@ -111,10 +111,11 @@ struct ScanToScanConfig {
   double startup_max_speed_mps = 30.0;
   double startup_search_step_m = 0.5;
   double startup_inlier_distance_m = 0.1;
-  // The seeds are refined and scored on about this many of the sweep's sharp and flat points (every k-th),
-  // and the winner on all of them: a 64-beam sweep has ~2,300, and refining 14 seeds on all took ~170 ms of
-  // one core. The screen keeps the winner (kitti_mini 00-02, the start-speed tests). 0 = all points.
-  int startup_screen_points = 500;
+  // The seeds are refined and scored on at least this many of the sweep's sharp and flat points (every k-th,
+  // k = points / this), and the winner on all of them: a 64-beam sweep has ~2,300, and refining 14 seeds on
+  // all took ~170 ms of one core (200: ~40 ms); a 16-beam sweep's ~580 are halved. The screen keeps the
+  // winner (kitti_mini 00-02, the start-speed tests). 0 = all points.
+  int startup_screen_points = 200;
   // Reference sweep: a sweep is registered against the last sweep that moved the robot at least
   // keep_reference_within_m or keep_reference_within_rad from the one before it, not always the previous
   // sweep. At rest (or crawling) consecutive registrations each err by a few mm and a few hundredths of a
