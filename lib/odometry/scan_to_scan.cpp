@@ -169,9 +169,10 @@ std::optional<LineFit> ScanToScanOdometry::fitLocalLine(const Eigen::Vector3d& q
   const int ring = previous_->corners.ring(j);
   thread_local std::vector<Eigen::Vector3d> pts;  // scratch, reused: no allocation per query
   pts.assign(1, previous_->corners.point(j));
+  const RingIndexedCloud::RingQuery query(q);
   for (int r = ring - config_.ring_window; r <= ring + config_.ring_window; ++r) {
     if (r == ring) continue;
-    const int k = previous_->corners.nearestInRing(r, q, max_sq, -1);
+    const int k = previous_->corners.nearestInRing(r, query, max_sq, -1);
     if (k >= 0) pts.push_back(previous_->corners.point(k));
   }
   if (static_cast<int>(pts.size()) < std::max(2, config_.line_min_rings)) return std::nullopt;
@@ -219,9 +220,10 @@ std::optional<PlaneFit> ScanToScanOdometry::fitLocalPlane(const Eigen::Vector3d&
   previous_->surfs.nearestK(q, config_.plane_neighbours, max_sq, near);
   if (near.empty()) return std::nullopt;
   const int ring = previous_->surfs.ring(near.front());
+  const RingIndexedCloud::RingQuery query(q);
   for (int r = ring - config_.ring_window; r <= ring + config_.ring_window; ++r) {
     if (r == ring) continue;
-    previous_->surfs.nearestKInRing(r, q, config_.ring_neighbours, max_sq, in_ring);
+    previous_->surfs.nearestKInRing(r, query, config_.ring_neighbours, max_sq, in_ring);
     for (int i : in_ring)
       if (std::find(near.begin(), near.end(), i) == near.end()) near.push_back(i);
   }
