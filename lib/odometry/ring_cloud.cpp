@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <numeric>
+#include <tuple>
 
 namespace adit {
 namespace {
@@ -37,25 +38,36 @@ RingIndexedCloud::RingIndexedCloud(const std::vector<LidarPoint>& points) {
   std::vector<Eigen::Vector3d> xyz;
   xyz.reserve(points.size());
   rings_.reserve(points.size());
-  int lo = 0, hi = -1;
   for (const LidarPoint& p : points) {
     if (!p.p.allFinite()) continue;
     xyz.push_back(p.p.cast<double>());
     rings_.push_back(p.ring);
-    if (hi < lo) lo = hi = p.ring;
-    lo = std::min<int>(lo, p.ring);
-    hi = std::max<int>(hi, p.ring);
   }
-  min_ring_ = lo;
-  by_ring_.resize(hi >= lo ? static_cast<std::size_t>(hi - lo + 1) : 0);
-  std::vector<std::vector<std::pair<float, int>>> order(by_ring_.size());
+  // Only the rings that hold points are kept (a corrupt 16-bit ring number costs at most a 64k-entry table
+  // for this build, not a ring structure per number), each as its (azimuth, index) pairs sorted (ties by
+  // index: deterministic).
+  const auto [lo, hi] = rings_.empty() ? std::pair<int, int>{0, -1}
+                                       : std::pair<int, int>{*std::min_element(rings_.begin(), rings_.end()),
+                                                             *std::max_element(rings_.begin(), rings_.end())};
+  std::vector<int> slot(static_cast<std::size_t>(hi - lo + 1), -1);  // ring number - lo -> ring kept
+  for (const int r : rings_) slot[static_cast<std::size_t>(r - lo)] = 0;
+  for (std::size_t k = 0; k < slot.size(); ++k) {
+    if (slot[k] < 0) continue;
+    slot[k] = static_cast<int>(ring_numbers_.size());
+    ring_numbers_.push_back(lo + static_cast<int>(k));
+  }
+  std::vector<std::vector<std::pair<float, int>>> order(ring_numbers_.size());
   for (std::size_t i = 0; i < xyz.size(); ++i) {
     const Eigen::Vector3f p = xyz[i].cast<float>();
-    order[static_cast<std::size_t>(rings_[i] - lo)].push_back({std::atan2(p.y(), p.x()), static_cast<int>(i)});
+    order[static_cast<std::size_t>(slot[static_cast<std::size_t>(rings_[i] - lo)])].push_back({std::atan2(p.y(), p.x()), static_cast<int>(i)});
   }
+  by_ring_.resize(order.size());
   for (std::size_t r = 0; r < order.size(); ++r) {
-    std::sort(order[r].begin(), order[r].end());  // (azimuth, index): ties by index, deterministic
+    std::sort(order[r].begin(), order[r].end());
     Ring& ring = by_ring_[r];
+    ring.azimuth.reserve(order[r].size());
+    ring.xyz.reserve(order[r].size());
+    ring.to_global.reserve(order[r].size());
     for (const auto& [azimuth, i] : order[r]) {
       ring.azimuth.push_back(azimuth);
       ring.xyz.push_back(xyz[static_cast<std::size_t>(i)].cast<float>());
@@ -66,10 +78,14 @@ RingIndexedCloud::RingIndexedCloud(const std::vector<LidarPoint>& points) {
 }
 
 const RingIndexedCloud::Ring* RingIndexedCloud::findRing(int ring) const {
-  const long r = static_cast<long>(ring) - min_ring_;
-  if (r < 0 || r >= static_cast<long>(by_ring_.size())) return nullptr;
-  const Ring& out = by_ring_[static_cast<std::size_t>(r)];
-  return out.azimuth.empty() ? nullptr : &out;
+  if (ring_numbers_.empty()) return nullptr;
+  // Rings usually run without gaps from the first: look there before searching.
+  const long guess = static_cast<long>(ring) - ring_numbers_.front();
+  if (guess >= 0 && guess < static_cast<long>(ring_numbers_.size()) && ring_numbers_[static_cast<std::size_t>(guess)] == ring)
+    return &by_ring_[static_cast<std::size_t>(guess)];
+  const auto it = std::lower_bound(ring_numbers_.begin(), ring_numbers_.end(), ring);
+  if (it == ring_numbers_.end() || *it != ring) return nullptr;
+  return &by_ring_[static_cast<std::size_t>(it - ring_numbers_.begin())];
 }
 
 // Walks outward from the query's azimuth both ways, nearer azimuth first, and stops where the azimuth alone

@@ -67,8 +67,8 @@ class RingIndexedCloud {
 
   KdTree3 all_;
   std::vector<int> rings_;
-  std::vector<Ring> by_ring_;    // ring number - first ring -> Ring (empty where no point)
-  int min_ring_ = 0;
+  std::vector<int> ring_numbers_;  // the rings that hold points, ascending
+  std::vector<Ring> by_ring_;      // the same order
 };
 
 }  // namespace adit

@@ -90,3 +90,27 @@ TEST(RingIndexedCloud, RingQueriesEqualABruteForceSearch) {
 
 }  // namespace
 }  // namespace adit
+
+namespace adit {
+namespace {
+
+// A corrupt message can carry any 16-bit ring number: only rings that hold points are kept, and each is found.
+TEST(RingIndexedCloud, FarApartRingNumbersAreFoundAndGapsAreEmpty) {
+  std::vector<LidarPoint> points(3);
+  points[0].p = Eigen::Vector3f(5.0f, 0.0f, 0.0f);
+  points[0].ring = 0;
+  points[1].p = Eigen::Vector3f(5.0f, 0.1f, 0.0f);
+  points[1].ring = 65535;
+  points[2].p = Eigen::Vector3f(-5.0f, 0.0f, 0.0f);
+  points[2].ring = 65535;
+  const RingIndexedCloud cloud(points);
+  const Eigen::Vector3d q(5.0, 0.05, 0.0);
+  EXPECT_EQ(cloud.nearestInRing(0, q, 1.0, -1), 0);
+  EXPECT_EQ(cloud.nearestInRing(65535, q, 1.0, -1), 1);
+  EXPECT_EQ(cloud.nearestKInRing(65535, q, 5, 1e3), (std::vector<int>{1, 2}));
+  EXPECT_EQ(cloud.nearestInRing(30000, q, 1e3, -1), -1);
+  EXPECT_EQ(cloud.nearestInRing(-1, q, 1e3, -1), -1);
+}
+
+}  // namespace
+}  // namespace adit
