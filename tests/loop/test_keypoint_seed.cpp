@@ -261,6 +261,35 @@ TEST(KeypointSeed, RefusesAPlaceWhereKeypointsAndScanContextFindTwoFitsTheOdomet
   EXPECT_EQ(agreed.loops.size(), 1u);
 }
 
+TEST(LoopJob, RefusesAPlaceWhereScanContextAndGraphSeedsFindTwoFitsTheOdometryCannotTellApart) {
+  // The same periodic roadway; the query is one period (20 m) past the candidate keyframe, where the graph
+  // rightly puts it. Scan Context matched the two because the place looks the same: its seed (the same place)
+  // fits tightly 20 m short of the truth, and used to be the loop. ICP from the graph's seed fits at the truth;
+  // with the odometry uncertain by 10 m both pass its gate: no loop.
+  const BoxWorld world = adit::testing::makePeriodicRoadway(9, 20.0, 10, 4.0, -4, 5);
+  const Eigen::Isometry3d match = poseXYYaw(0, 0, 1.8, 0);
+  const Eigen::Isometry3d query = poseXYYaw(20.3, 0.5, 1.8, 3 * kDeg);
+  const Sweep q = sweepAt(world, query, 7);
+  LoopJob job = jobWithBadSeeds(match, query, q, neighbourhoodAt(world, match, 24), Eigen::Isometry3d::Identity());
+  job.candidates[0].candidate.yaw = -3 * kDeg;
+  LoopBook book;
+  const LoopJobOutcome out = runLoopJob(job, book, jobConfig(false));
+  std::printf("ambiguous %d, loops %zu\n", out.counts.rejected_ambiguous, out.loops.size());
+  EXPECT_EQ(out.counts.rejected_ambiguous, 1);
+  EXPECT_TRUE(out.loops.empty());
+
+  // Where the odometry is sure (0.5 m between the visits), it rules the Scan Context seed's fit out, and the
+  // graph's fit, which only checked it, is not taken in its place: no loop, as before the check.
+  job.chain = OdometryChain();
+  job.chain.add(match, Matrix6d::Zero());
+  job.chain.add(query, Matrix6d::Identity() * 0.25);
+  LoopBook sure_book;
+  const LoopJobOutcome sure = runLoopJob(job, sure_book, jobConfig(false));
+  EXPECT_EQ(sure.counts.rejected_ambiguous, 0);
+  EXPECT_EQ(sure.counts.rejected_odometry, 1);
+  EXPECT_TRUE(sure.loops.empty());
+}
+
 TEST(KeypointSeed, KeyframeKeypointsSurviveACheckpointAndOlderRecordsStillLoad) {
   const BoxWorld world = adit::testing::makeRoadway(11, 8.0, 24);
   LoopCloser closer;

@@ -15,6 +15,7 @@
 #include <unistd.h>
 
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <functional>
 #include <map>
@@ -100,6 +101,10 @@ inline SimPipelineRun runSimPipeline(const std::string& world, double duration_s
     run.worst_loop_error_deg = std::max(run.worst_loop_error_deg, degrees);
     const bool wrong = metres > kFalseLoopMetres || degrees > kFalseLoopDegrees;
     if (wrong) ++run.false_loops;
+    if (wrong)  // what a wrong loop looked like to the verifier, for whoever has to find out why it passed
+      std::fprintf(stderr, "false loop: query %.1f s -> match %.1f s, %.2f m / %.2f deg off the truth (ICP rms %.3f m, inliers %.2f, Scan Context %.3f)\n",
+                   toSeconds(loop.query_utime), toSeconds(loop.match_utime), metres, degrees, loop.fitness,
+                   loop.inlier_ratio, loop.scan_context_distance);
     run.judged_loops.push_back({loop.query_utime, !wrong});
   }
   fs::remove_all(options.out_dir);
