@@ -1,5 +1,7 @@
 #include "odometry/ring_cloud.hpp"
 
+#include "registration/k_best.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -118,14 +120,7 @@ int RingIndexedCloud::searchRing(const Ring& ring, const RingQuery& query, int k
     const int global = ring.to_global[static_cast<std::size_t>(pos)];
     const float dist = squaredDistance(q, ring.xyz[static_cast<std::size_t>(pos)]);
     if (!(dist < worst()) || global == exclude) continue;
-    int i = std::min(count, k - 1);
-    for (; i > 0 && dists[i - 1] > dist; --i) {  // equal distances keep the earlier-met point first
-      dists[i] = dists[i - 1];
-      indices[i] = indices[i - 1];
-    }
-    dists[i] = dist;
-    indices[i] = global;
-    count = std::min(count + 1, k);
+    insertKBest(dist, global, k, count, dists, indices);
     if (count == k) stop = stopAzimuth(h, dists[k - 1]);
   }
   return count;

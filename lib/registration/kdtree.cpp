@@ -1,5 +1,7 @@
 #include "registration/kdtree.hpp"
 
+#include "registration/k_best.hpp"
+
 #include <nanoflann.hpp>
 
 #include <algorithm>
@@ -31,14 +33,7 @@ class BoundedKnn {
   float worstDist() const { return count_ < k_ ? max_sq_ : dists_[k_ - 1]; }
   bool addPoint(float dist, std::uint32_t index) {
     if (!(dist < worstDist()) || static_cast<std::int64_t>(index) == exclude_) return true;
-    int i = std::min(count_, k_ - 1);
-    for (; i > 0 && dists_[i - 1] > dist; --i) {  // equal distances keep the earlier-met point first
-      dists_[i] = dists_[i - 1];
-      indices_[i] = indices_[i - 1];
-    }
-    dists_[i] = dist;
-    indices_[i] = index;
-    count_ = std::min(count_ + 1, k_);
+    insertKBest(dist, index, k_, count_, dists_, indices_);
     return true;
   }
 
