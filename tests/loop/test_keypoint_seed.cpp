@@ -85,6 +85,14 @@ LoopJob jobWithBadSeeds(const Eigen::Isometry3d& match, const Eigen::Isometry3d&
   return job;
 }
 
+// An odometry chain sure of the way between the two visits to 0.5 m (one sigma per axis).
+OdometryChain sureChain(const Eigen::Isometry3d& match, const Eigen::Isometry3d& query) {
+  OdometryChain chain;
+  chain.add(match, Matrix6d::Zero());
+  chain.add(query, Matrix6d::Identity() * 0.25);
+  return chain;
+}
+
 LoopCloserConfig jobConfig(bool keypoints) {
   LoopCloserConfig c;
   c.keypoints.use = keypoints;
@@ -243,9 +251,7 @@ TEST(KeypointSeed, RefusesAPlaceWhereKeypointsAndScanContextFindTwoFitsTheOdomet
   // Where the odometry is sure enough to rule the other place out (0.5 m between the visits, not 10 m), the
   // fit it allows is the loop.
   LoopJob sure = job;
-  sure.chain = OdometryChain();
-  sure.chain.add(match, Matrix6d::Zero());
-  sure.chain.add(query, Matrix6d::Identity() * 0.25);
+  sure.chain = sureChain(match, query);
   LoopBook sure_book;
   const LoopJobOutcome resolved = runLoopJob(sure, sure_book, jobConfig(true));
   EXPECT_EQ(resolved.counts.rejected_ambiguous, 0);
@@ -280,9 +286,7 @@ TEST(LoopJob, RefusesAPlaceWhereScanContextAndGraphSeedsFindTwoFitsTheOdometryCa
 
   // Where the odometry is sure (0.5 m between the visits), it rules the Scan Context seed's fit out, and the
   // graph's fit, which only checked it, is not taken in its place: no loop, as before the check.
-  job.chain = OdometryChain();
-  job.chain.add(match, Matrix6d::Zero());
-  job.chain.add(query, Matrix6d::Identity() * 0.25);
+  job.chain = sureChain(match, query);
   LoopBook sure_book;
   const LoopJobOutcome sure = runLoopJob(job, sure_book, jobConfig(false));
   EXPECT_EQ(sure.counts.rejected_ambiguous, 0);
