@@ -5,8 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <numeric>
-#include <tuple>
+#include <utility>
 
 namespace adit {
 namespace {
@@ -90,12 +89,12 @@ const RingIndexedCloud::Ring* RingIndexedCloud::findRing(int ring) const {
   return &by_ring_[static_cast<std::size_t>(it - ring_numbers_.begin())];
 }
 
-// Walks outward from the query's azimuth both ways, nearer azimuth first, and stops where the azimuth alone
-// puts every remaining point beyond the k-th best (or the bound).
 RingIndexedCloud::RingQuery::RingQuery(const Eigen::Vector3d& query)
     : q(query.cast<float>()), h(std::sqrt(q.x() * q.x() + q.y() * q.y())), azimuth(std::atan2(q.y(), q.x())),
       finite(query.allFinite()) {}
 
+// Walks outward from the query's azimuth both ways, nearer azimuth first, and stops where the azimuth alone
+// puts every remaining point beyond the k-th best (or the bound).
 int RingIndexedCloud::searchRing(const Ring& ring, const RingQuery& query, int k, float max_sq, int exclude,
                                  float* dists, int* indices) const {
   const Eigen::Vector3f& q = query.q;
