@@ -126,9 +126,9 @@ ScanToMapMapper::Sweep ScanToMapMapper::prepare(const FeatureSet& f) const {
 void ScanToMapMapper::downsample(Sweep& s) const {
   s.corner_points = voxelDownsample(toDouble(s.corners), config_.corner_resolution_m);
   s.surf_points = voxelDownsample(toDouble(s.surfs), config_.surf_resolution_m);
-  s.surf_queries = config_.surf_query_resolution_m > config_.surf_resolution_m
-                       ? voxelDownsample(s.surf_points, config_.surf_query_resolution_m)
-                       : s.surf_points;
+  s.surf_queries.clear();
+  if (config_.surf_query_resolution_m > config_.surf_resolution_m)
+    s.surf_queries = voxelDownsample(s.surf_points, config_.surf_query_resolution_m);
 }
 
 void ScanToMapMapper::compensate(Sweep& s, const Eigen::Isometry3d& T_prev_curr, double gap_s) const {
@@ -153,9 +153,10 @@ ScanToMapMapper::Refinement ScanToMapMapper::refine(const Sweep& sweep, const Ei
                                                      int& iterations) const {
   Refinement out;
   out.pose = predicted;
-  MatchReuse reuse(sweep.corner_points.size(), sweep.surf_queries.size(), config_.registration.reuse_match_distance_m);
+  const std::vector<Eigen::Vector3d>& surfs = sweep.registeredSurfs();
+  MatchReuse reuse(sweep.corner_points.size(), surfs.size(), config_.registration.reuse_match_distance_m);
   for (int round = 0; round < std::max(1, config_.outer_iterations); ++round) {
-    out.result = registerStep(match(sweep.corner_points, sweep.surf_queries, out.pose, &reuse), out.pose, predicted,
+    out.result = registerStep(match(sweep.corner_points, surfs, out.pose, &reuse), out.pose, predicted,
                               config_.registration);
     iterations += out.result.iterations;
     if (!(out.ok = out.result.ok)) break;

@@ -134,7 +134,9 @@ class ScanToMapMapper {
     bool raw = false;
     std::vector<LidarPoint> corners, surfs, cloud;
     std::vector<Eigen::Vector3d> corner_points, surf_points;  // downsampled corners / surfs (into the maps)
-    std::vector<Eigen::Vector3d> surf_queries;  // surf_points at surf_query_resolution_m (registered)
+    std::vector<Eigen::Vector3d> surf_queries;  // surf_points at surf_query_resolution_m, if coarser
+    // The surface points the sweep registers with: no copy of surf_points where the resolutions are equal.
+    const std::vector<Eigen::Vector3d>& registeredSurfs() const { return surf_queries.empty() ? surf_points : surf_queries; }
   };
   struct Refinement {
     bool ok = false;
