@@ -39,11 +39,13 @@ std::optional<LineFit> fitLine(const std::vector<Eigen::Vector3d>& points, doubl
   return LineFit{m.centroid, m.eigenvectors.col(2).normalized()};
 }
 
-std::optional<PlaneFit> fitPlane(const std::vector<Eigen::Vector3d>& points, double max_point_distance) {
+std::optional<PlaneFit> fitPlane(const std::vector<Eigen::Vector3d>& points, double max_point_distance,
+                                 double min_spread_ratio) {
   if (points.size() < 3) return std::nullopt;
   const Moments m = moments(points);
   // In-plane spread must dominate: collinear neighbours leave the normal undetermined.
   if (!(m.eigenvalues[1] > 1e-6) || m.eigenvalues[1] < 4.0 * m.eigenvalues[0]) return std::nullopt;
+  if (m.eigenvalues[1] < min_spread_ratio * m.eigenvalues[2]) return std::nullopt;  // one curve, e.g. a ring's arc
   PlaneFit fit;
   fit.normal = m.eigenvectors.col(0).normalized();
   fit.offset = -fit.normal.dot(m.centroid);

@@ -24,7 +24,11 @@ std::optional<LineFit> fitLine(const std::vector<Eigen::Vector3d>& points, doubl
 
 // The total-least-squares plane (smallest covariance eigenvector through the centroid). Rejected when any
 // point is farther than max_point_distance from it (not one plane: a corner, a step, clutter) or when the
-// points are nearly collinear (the normal would be arbitrary).
-std::optional<PlaneFit> fitPlane(const std::vector<Eigen::Vector3d>& points, double max_point_distance);
+// points are nearly collinear (the normal would be arbitrary). With min_spread_ratio > 0 also rejected when
+// the points lie along one curve: the middle covariance eigenvalue below min_spread_ratio times the largest.
+// A few points of one lidar ring on a curved wall are such a curve, and the plane through them is the
+// ring's own plane, not the wall's (see mapping.plane_min_spread).
+std::optional<PlaneFit> fitPlane(const std::vector<Eigen::Vector3d>& points, double max_point_distance,
+                                 double min_spread_ratio = 0.0);
 
 }  // namespace adit
