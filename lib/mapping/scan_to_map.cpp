@@ -34,6 +34,8 @@ MapperConfig aloamMapperConfig() {
   m.registration.max_solver_iterations = 4;
   m.registration.reuse_match_distance_m = 0.0;  // A-LOAM searches every round afresh
   m.plane_through_nearest = false;
+  m.plane_min_spread = 0.0;
+  m.plane_wide_neighbours = 0;
   m.line_through_nearest = false;
   m.thin_within_sweep = true;
   return m;
@@ -55,6 +57,8 @@ const ConfigTable<MapperConfig>& mapperConfigTable() {
      .add("line_eigen_ratio", &M::line_eigen_ratio, atLeast(1), "", "edge if the largest eigenvalue exceeds ratio * the second (A-LOAM: 3)")
      .add("plane_max_point_distance_m", &M::plane_max_point_distance_m, above(0), "m", "a plane is rejected if a neighbour is farther (A-LOAM: 0.2)")
      .add("plane_through_nearest", &M::plane_through_nearest, anyValue(), "", "a surface match's plane passes through the nearest map point, not the neighbours' centroid (A-LOAM: false)")
+     .add("plane_min_spread", &M::plane_min_spread, between(0, 1), "", "a plane is rejected if its neighbours lie along one curve: middle eigenvalue below this times the largest (a ring's arc; A-LOAM: 0)")
+     .add("plane_wide_neighbours", &M::plane_wide_neighbours, between(0, 100), "points", "a rejected plane is fitted again to this many nearest (0: not; A-LOAM: 0)")
      .add("line_through_nearest", &M::line_through_nearest, anyValue(), "", "an edge match's line passes through the nearest map point, not the neighbours' centroid (A-LOAM: false)")
      .add("thin_within_sweep", &M::thin_within_sweep, anyValue(), "", "a sweep's points are also thinned against each other as they enter the local map, not only against earlier sweeps (A-LOAM; 64 beams)")
      .add("local_map_radius_m", &M::local_map_radius_m, above(0), "m", "map points farther from the robot are dropped (bounds memory)")
@@ -101,7 +105,12 @@ Correspondences ScanToMapMapper::match(const std::vector<Eigen::Vector3d>& corne
       thread_local std::vector<Eigen::Vector3d> near;
       surf_map_.nearest(q, k, config_.max_neighbour_distance_m, near);
       if (static_cast<int>(near.size()) < k) return std::nullopt;
-      const auto plane = fitPlane(near, config_.plane_max_point_distance_m);
+      auto plane = fitPlane(near, config_.plane_max_point_distance_m, config_.plane_min_spread);
+      if (!plane && config_.plane_wide_neighbours > k) {  // one ring's arc, perhaps: look wider
+        thread_local std::vector<Eigen::Vector3d> wide;
+        surf_map_.nearest(q, config_.plane_wide_neighbours, config_.max_neighbour_distance_m, wide);
+        plane = fitPlane(wide, config_.plane_max_point_distance_m, config_.plane_min_spread);
+      }
       if (!plane) return std::nullopt;
       // VoxelMap::nearest lists the neighbours nearest first.
       const double offset = config_.plane_through_nearest ? -plane->normal.dot(near.front()) : plane->offset;
