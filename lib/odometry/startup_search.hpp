@@ -18,12 +18,12 @@ namespace adit {
 // of +step, -step, +2 step, -2 step, ... up to +-max_distance_m. step_m <= 0 or max_distance_m < step_m gives the prior alone.
 std::vector<Eigen::Isometry3d> startupHypotheses(const Eigen::Isometry3d& prior, double max_distance_m, double step_m);
 
-// Correspondences whose residual at pose T (reference_T_sweep) is below max_residual_m: how much of the
-// sweep a candidate pose explains. Counted, not summed, so a far-off pose with few matches cannot win by
-// having small residuals.
 // Stride of a screen of about screen_points out of `points` (1: every point; screen_points 0: no screen).
 std::size_t screenStride(std::size_t points, int screen_points);
 
+// Correspondences whose residual at pose T (reference_T_sweep) is below max_residual_m: how much of the
+// sweep a candidate pose explains. Counted, not summed, so a far-off pose with few matches cannot win by
+// having small residuals.
 int inlierCount(const Correspondences& matches, const Eigen::Isometry3d& T, double max_residual_m);
 
 }  // namespace adit
