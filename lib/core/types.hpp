@@ -103,6 +103,7 @@ struct PoseEstimate {
   static constexpr std::int32_t kSeededByImu = 16;
   static constexpr std::int32_t kRegistrationFailed = 32;
   static constexpr std::int32_t kLoopCorrected = 64;
+  static constexpr std::int32_t kStandingStill = 512;  // the pose is held (odometry/standstill.hpp)
   std::int32_t flags = 0;
   int iterations = 0;
   double final_cost = 0.0;

@@ -38,6 +38,7 @@ MapperConfig aloamMapperConfig() {
   m.plane_wide_neighbours = 0;
   m.line_through_nearest = false;
   m.thin_within_sweep = true;
+  m.standstill.window_sweeps = 0;  // every registration is the pose
   return m;
 }
 
@@ -46,6 +47,7 @@ const ConfigTable<MapperConfig>& mapperConfigTable() {
   static const ConfigTable<M> table = [] {
     ConfigTable<M> t("mapping");
     t.nest(&M::registration, registrationConfigTable("mapping"))
+     .nest(&M::standstill, standstillConfigTable("mapping.standstill"))
      .add("outer_iterations", &M::outer_iterations, between(1, 100), "", "correspondence rounds per sweep (A-LOAM: 2)")
      .add("corner_resolution_m", &M::corner_resolution_m, between(0.01, 10), "m", "resolution of edge points in the sweep and the map")
      .add("surf_resolution_m", &M::surf_resolution_m, between(0.01, 10), "m", "resolution of surface points in the sweep and the map")
@@ -82,7 +84,8 @@ ScanToMapMapper::ScanToMapMapper(MapperConfig config)
       surf_map_(config_.map_voxel_size_m, config_.surf_resolution_m, config_.max_points_per_voxel),
       global_map_(config_.global_map_resolution_m, static_cast<std::size_t>(config_.global_map_max_voxels)),
       pool_(config_.registration.search_threads > 1 ? std::make_shared<ChunkPool>(config_.registration.search_threads)
-                                                    : nullptr) {}
+                                                    : nullptr),
+      standstill_(config_.standstill) {}
 
 Correspondences ScanToMapMapper::match(const std::vector<Eigen::Vector3d>& corners,
                                        const std::vector<Eigen::Vector3d>& surfs, const Eigen::Isometry3d& T,
@@ -209,17 +212,24 @@ PoseEstimate ScanToMapMapper::process(const FeatureSet& f, const PoseEstimate& o
     }
   }
   if (first || (out.flags & PoseEstimate::kRegistrationFailed)) out.covariance = odometry.covariance;
+  // The drift correction follows the registration, held or not: it seeds the next sweep.
   T_map_odom_ = T * odom.inverse();
+  out.pose = T;
+  if (first || (out.flags & PoseEstimate::kRegistrationFailed)) {
+    standstill_.reset();
+  } else {
+    out.pose = standstill_.update(f.utime, T);
+    if (standstill_.holding()) out.flags |= PoseEstimate::kStandingStill;
+  }
   if (config_.compensate_raw_sweeps && sweep.raw && !have_motion) {
     pending_ = std::move(sweep);
     pending_pose_ = T;
-  } else {
+  } else if (!standstill_.holding()) {
     addToMaps(sweep, T);
   }
   has_previous_ = true;
   previous_utime_ = f.utime;
   previous_odometry_ = odom;
-  out.pose = T;
   return out;
 }
 
@@ -229,6 +239,7 @@ void ScanToMapMapper::applyCorrection(const Eigen::Isometry3d& T_corrected_uncor
   corner_map_.transform(T_corrected_uncorrected);
   pending_pose_ = T_corrected_uncorrected * pending_pose_;
   surf_map_.transform(T_corrected_uncorrected);
+  standstill_.applyCorrection(T_corrected_uncorrected);
   corrected_ = true;
 }
 

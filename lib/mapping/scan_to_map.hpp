@@ -8,6 +8,7 @@
 #include "core/types.hpp"
 #include "mapping/global_map.hpp"
 #include "mapping/voxel_map.hpp"
+#include "odometry/standstill.hpp"
 #include "registration/correspondences.hpp"
 #include "registration/solver.hpp"
 
@@ -91,6 +92,10 @@ struct MapperConfig {
   // Compensate sweeps that arrive raw (not deskewed) with the odometry motion before they enter the map: a
   // smeared sweep in the map misleads every later one (KITTI start-up: 0.2 m / 0.7 deg errors without).
   bool compensate_raw_sweeps = true;
+  // A robot standing still reports the mean of its registrations and leaves the map as it is
+  // (odometry/standstill.hpp; keys mapping.standstill.*). Measured at rest for 60 s, noisy lidar and IMU,
+  // idling chassis: see the README's "Standing still" paragraph.
+  StandstillConfig standstill;
 };
 
 // Plain A-LOAM laserMapping behaviour for the ablation: no degeneracy prior, raw sweeps enter the map as they
@@ -176,6 +181,7 @@ class ScanToMapMapper {
   Eigen::Isometry3d previous_odometry_ = Eigen::Isometry3d::Identity();
   std::optional<Sweep> pending_;  // first raw sweep, waiting for a motion estimate
   Eigen::Isometry3d pending_pose_ = Eigen::Isometry3d::Identity();
+  StandstillHold standstill_;
 };
 
 }  // namespace adit

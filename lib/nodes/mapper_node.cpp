@@ -101,6 +101,7 @@ class MapperNode : public runtime::Node, public WritesProducts {
     if (mapped.flags & PoseEstimate::kRegistrationFailed) count("registration_failed");
     if (mapped.flags & PoseEstimate::kDegenerateTranslation) count("degenerate_translation");
     if (mapped.flags & PoseEstimate::kDegenerateRotation) count("degenerate_rotation");
+    if (mapped.flags & PoseEstimate::kStandingStill) count("standing_still");
     adit::odometry_t out = msg::toMessage(mapped, &features);
     splitPose(applied_, out.loop_correction_position, out.loop_correction_orientation);
     publish("mapped", out);

@@ -102,6 +102,27 @@ TEST(Mapper, CorrectionMovesLocalMapAndFuturePoses) {
   }
 }
 
+// A robot standing still (odometry/standstill.hpp): after mapping.standstill.window_sweeps still sweeps the
+// mapper flags its poses kStandingStill, reports one position and leaves its maps as they are; then it drives
+// on and maps again.
+TEST(Mapper, StandingStillHoldsThePositionAndLeavesTheMap) {
+  ScanToMapMapper mapper;
+  const int window = MapperConfig{}.standstill.window_sweeps;
+  const DriveResult rest = drive(mapper, 40, 0.0);
+  for (int i = 0; i < 40; ++i)
+    EXPECT_EQ(static_cast<bool>(rest.mapped[i].flags & PoseEstimate::kStandingStill), i >= window) << i;  // 0: first
+  for (int i = window; i < 40; ++i) {
+    EXPECT_EQ(rest.map_points[i], rest.map_points[window - 1]) << i;
+    EXPECT_LT((rest.mapped[i].pose.translation() - rest.mapped[window].pose.translation()).norm(), 0.002) << i;
+  }
+  // Driving on at 0.5 m a sweep from 2 m further (a fresh odometry started at that pose in the mapper's frame).
+  const DriveResult on = drive(mapper, 10, 0.05, 40, truthAt(0.0).inverse() * truthAt(2.0));
+  for (const PoseEstimate& p : on.mapped) EXPECT_FALSE(p.flags & PoseEstimate::kStandingStill);
+  EXPECT_GT(on.map_points.back(), rest.map_points.back());
+  const Eigen::Isometry3d truth = truthAt(0.0).inverse() * on.truth.back();  // in the mapper's frame
+  EXPECT_LT((truth.inverse() * on.mapped.back().pose).translation().norm(), 0.05);
+}
+
 TEST(Mapper, GlobalMapIsDownsampledAndDeterministic) {
   ScanToMapMapper a, b;
   drive(a, 5, 0.5);
