@@ -168,7 +168,8 @@ class ConfigTable {
     return *this;
   }
 
-  // Folds the fields of a sub-struct's table (keys kept as that table names them).
+  // Folds the fields of a sub-struct's table (keys kept as that table names them). The defaults are the outer
+  // struct's: its member may start from other values than the sub-struct's own defaults.
   template <class Sub>
   ConfigTable& nest(Sub S::*member, const ConfigTable<Sub>& sub) {
     for (const ConfigField<Sub>& g : sub.fields()) {
@@ -176,6 +177,7 @@ class ConfigTable {
       f.info = g.info;
       f.read = [member, read = g.read](const Config& c, S& s) { read(c, s.*member); };
       f.format = [member, format = g.format](const S& s) { return format(s.*member); };
+      f.info.default_value = f.format(S{});
       fields_.push_back(std::move(f));
     }
     return *this;
