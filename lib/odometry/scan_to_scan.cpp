@@ -45,6 +45,7 @@ ScanToScanConfig aloamOdometryConfig() {
   s.gyro_rotation_sigma_rad = 0.0;  // A-LOAM has no IMU
   s.keep_reference_within_m = 0.0;  // A-LOAM registers against the previous sweep, always
   s.keep_reference_within_rad = 0.0;
+  s.standstill.window_sweeps = 0;  // every registration is the pose
   return s;
 }
 
@@ -62,6 +63,7 @@ const ConfigTable<ScanToScanConfig>& scanToScanConfigTable() {
   static const ConfigTable<S> table = [] {
     ConfigTable<S> t("odometry");
     t.nest(&S::registration, registrationConfigTable("odometry"))
+     .nest(&S::standstill, standstillConfigTable("odometry.standstill"))
      .add("outer_iterations", &S::outer_iterations, between(1, 100), "", "correspondence rounds per sweep (A-LOAM: 2)")
      .add("max_match_distance_m", &S::max_match_distance_m, above(0), "m", "largest point-to-neighbour distance accepted when matching")
      .add("ring_window", &S::ring_window, between(0, 64), "rings", "rings either side searched for the second line / third plane point")
@@ -99,7 +101,8 @@ ScanToScanConfig scanToScanConfigFrom(const Config& c) {
 ScanToScanOdometry::ScanToScanOdometry(ScanToScanConfig config)
     : config_(std::move(config)),
       pool_(config_.registration.search_threads > 1 ? std::make_shared<ChunkPool>(config_.registration.search_threads)
-                                                    : nullptr) {}
+                                                    : nullptr),
+      standstill_(config_.standstill) {}
 
 void ScanToScanOdometry::reset() { *this = ScanToScanOdometry(config_); }
 
@@ -467,6 +470,12 @@ PoseEstimate ScanToScanOdometry::process(const FeatureSet& f, const std::optiona
     pose_ = reference_pose_ * T;
   }
   out.pose = pose_;
+  if (has_previous_ && r.ok) {
+    out.pose = standstill_.update(f.utime, pose_);
+    if (standstill_.holding()) out.flags |= PoseEstimate::kStandingStill;
+  } else {
+    standstill_.reset();
+  }
   // A compensated raw sweep counts as deskewed from now on (a reference kept after its compensation too).
   reference_kept_ = has_previous_ && r.ok && keepsReference(T);
   if (reference_kept_) {

@@ -11,6 +11,7 @@
 #include "registration/pose_increment.hpp"
 #include "registration/solver.hpp"
 #include "odometry/ring_cloud.hpp"
+#include "odometry/standstill.hpp"
 
 #include <future>
 #include <memory>
@@ -125,6 +126,16 @@ struct ScanToScanConfig {
   // previous sweep (A-LOAM).
   double keep_reference_within_m = 0.1;
   double keep_reference_within_rad = 0.0175;
+  // A robot standing still reports the mean position of its registrations against the kept reference
+  // (odometry/standstill.hpp; keys odometry.standstill.*); the next sweep still registers from its own. One
+  // registration against the reference errs by 6-8 mm per axis on a noisy 16-beam lidar and an idling
+  // chassis, twice the mapper's, hence a looser speed bound than the mapper's (at rest the 2 s line's slope
+  // stays within ~10 mm/s): README, "Standing still".
+  StandstillConfig standstill = [] {
+    StandstillConfig c;
+    c.max_speed_mps = 0.02;
+    return c;
+  }();
 };
 
 // Plain A-LOAM laserOdometry behaviour, for the "before vs after" ablation: motion-model seed only (LinK3D
@@ -182,6 +193,8 @@ class ScanToScanOdometry {
   Correspondences match(const std::vector<LidarPoint>& sharp, const std::vector<LidarPoint>& flat,
                         const Eigen::Isometry3d& T_prev_curr, MatchReuse* reuse = nullptr) const;
 
+  // T_odom_lidar of the last registration, what the next sweep registers from (the pose process() reported
+  // may be held instead: standstill).
   const Eigen::Isometry3d& pose() const { return pose_; }
   const ScanToScanConfig& config() const { return config_; }
   // The velocity (tangent, per second) of the last step (zero before two sweeps) and the time of the last
@@ -255,6 +268,7 @@ class ScanToScanOdometry {
   Eigen::Vector3d weakest_translation_ = Eigen::Vector3d::UnitX();
   void updateHeldVelocity(const Eigen::Isometry3d& T_prev_curr, std::int64_t gap_us,
                           const Matrix6d* information = nullptr);
+  StandstillHold standstill_;
 };
 
 }  // namespace adit

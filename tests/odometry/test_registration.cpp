@@ -138,6 +138,39 @@ TEST(ScanToScan, AtRestTheReferenceSweepIsKeptAndErrorsDoNotAddUp) {
   }
 }
 
+// Standing still (odometry.standstill): after a window of still registrations the reported position is their
+// mean, flagged kStandingStill, while each sweep still registers from its own estimate (pose()).
+TEST(ScanToScan, StandingStillReportsTheMeanPositionOfItsRegistrations) {
+  const auto world = test::boxRoom();
+  test::LidarModel noisy;
+  noisy.range_noise = 0.03;
+  const int window = ScanToScanConfig{}.standstill.window_sweeps;
+  ScanToScanOdometry odom;
+  Eigen::Isometry3d first_held = Eigen::Isometry3d::Identity();
+  double reported_moved = 0, registered_moved = 0;
+  for (int i = 0; i < 60; ++i) {
+    const PoseEstimate e = odom.process(test::simulateSweep(world, kStart, noisy, i * 100000, 700 + i));
+    EXPECT_EQ(static_cast<bool>(e.flags & PoseEstimate::kStandingStill), i >= window) << i;  // 0: first sweep
+    if (i == window) first_held = e.pose;
+    if (i <= window) continue;
+    reported_moved = std::max(reported_moved, translationError(first_held, e.pose));
+    registered_moved = std::max(registered_moved, translationError(first_held, odom.pose()));
+    EXPECT_LT(rotationErrorDeg(e.pose, odom.pose()), 1e-9) << i;  // the rotation is the registration's
+  }
+  std::printf("at rest, 60 noisy sweeps: reported position moved %.2f mm, registrations %.2f mm\n",
+              1e3 * reported_moved, 1e3 * registered_moved);
+  EXPECT_LT(reported_moved, 0.3 * registered_moved);
+
+  ScanToScanConfig off;
+  off.standstill.window_sweeps = 0;
+  ScanToScanOdometry unheld(off);
+  for (int i = 0; i < 30; ++i) {
+    const PoseEstimate e = unheld.process(test::simulateSweep(world, kStart, noisy, i * 100000, 700 + i));
+    EXPECT_FALSE(e.flags & PoseEstimate::kStandingStill);
+    EXPECT_TRUE(e.pose.isApprox(unheld.pose()));
+  }
+}
+
 // At rest with a gyro whose bias is not quite removed: the weighed gyro's step starts from the previous estimate
 // against the kept reference, so its prior carries that estimate's uncertainty too, and the lidar's view of the
 // reference keeps the rotation from walking with the bias (held to the step's sigma alone it walked 0.44 deg in
