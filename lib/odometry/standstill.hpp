@@ -34,7 +34,7 @@ struct StandstillConfig {
   double leave_angle_rad = 0.0105;  // 0.6 deg
 };
 
-// Keys "<prefix>.*" (the mapper's: "mapping.standstill").
+// Keys "<prefix>.*" ("mapping.standstill", "odometry.standstill").
 ConfigTable<StandstillConfig> standstillConfigTable(const std::string& prefix);
 
 class StandstillHold {
@@ -42,7 +42,8 @@ class StandstillHold {
   explicit StandstillHold(StandstillConfig config = {}) : config_(config) {}
 
   // The registered pose T_world_lidar of the sweep at utime (in time order). Returns the pose to report:
-  // `registered` itself while the robot moves, the mean of the still registrations while it stands.
+  // `registered` itself while the robot moves; while it stands, `registered` with the mean position of the
+  // still registrations.
   Eigen::Isometry3d update(std::int64_t utime, const Eigen::Isometry3d& registered);
   // True from the sweep that started a hold until the one that ended it.
   bool holding() const { return holding_; }
