@@ -211,15 +211,16 @@ PoseEstimate ScanToMapMapper::process(const FeatureSet& f, const PoseEstimate& o
       out.flags |= PoseEstimate::kRegistrationFailed;
     }
   }
-  if (first || (out.flags & PoseEstimate::kRegistrationFailed)) out.covariance = odometry.covariance;
+  const bool registered = !first && !(out.flags & PoseEstimate::kRegistrationFailed);
+  if (!registered) out.covariance = odometry.covariance;
   // The drift correction follows the registration, held or not: it seeds the next sweep.
   T_map_odom_ = T * odom.inverse();
   out.pose = T;
-  if (first || (out.flags & PoseEstimate::kRegistrationFailed)) {
-    standstill_.reset();
-  } else {
+  if (registered) {
     out.pose = standstill_.update(f.utime, T);
     if (standstill_.holding()) out.flags |= PoseEstimate::kStandingStill;
+  } else {
+    standstill_.reset();
   }
   if (config_.compensate_raw_sweeps && sweep.raw && !have_motion) {
     pending_ = std::move(sweep);

@@ -106,7 +106,7 @@ class OdometryNode : public runtime::Node {
     if (guess.flags & PoseEstimate::kSeededByLinK3d) count("seeded_by_link3d");
     if (guess.flags & PoseEstimate::kSeededByImu) count("seeded_by_imu");
     const std::optional<WheelMotionEstimate> wheel = wheelMotion(features.utime, guess);
-    const Eigen::Isometry3d before = odometry_.pose();  // the registrations' own poses (not a held one)
+    const Eigen::Isometry3d before = odometry_.pose();
     const std::int64_t previous_utime = odometry_.lastUtime();
     const std::optional<RotationPrior> gyro = gyroRotation(imu, previous_utime, features.utime);
     if (gyro) count("gyro_rotation_weighed");
@@ -114,8 +114,10 @@ class OdometryNode : public runtime::Node {
         features, guess.T_prev_curr, guess.flags,
         wheel ? std::optional<MeasuredMotion>(MeasuredMotion{wheel->T_prev_curr, wheel->sigma_translation_m}) : std::nullopt,
         gyro);
+    // The step between the registrations' own poses: the reported pose may be held (standstill).
+    const Eigen::Isometry3d step = before.inverse() * odometry_.pose();
     if (previous_utime >= 0) {
-      gyro_bias_.observe(raw_imu, previous_utime, features.utime, before.inverse() * odometry_.pose(),
+      gyro_bias_.observe(raw_imu, previous_utime, features.utime, step,
                          !(pose.flags & PoseEstimate::kRegistrationFailed));
       if (gyro_bias_.known()) {
         setCount("gyro_bias_stops", gyro_bias_.restPeriods());
@@ -136,7 +138,7 @@ class OdometryNode : public runtime::Node {
       const Eigen::Vector3d& ev = pose.translation_eigenvalues;  // ascending
       const bool degenerate = (pose.flags & PoseEstimate::kDegenerateTranslation) != 0;
       const double observed = degenerate || !(ev[2] > 0.0) ? 0.0 : ev[0] / ev[2];
-      wheel_.observe(before.inverse() * odometry_.pose(), observed, toSeconds(features.utime - previous_utime), wheel);
+      wheel_.observe(step, observed, toSeconds(features.utime - previous_utime), wheel);
     }
     reportWheel();
     previous_ = features;

@@ -446,7 +446,8 @@ PoseEstimate ScanToScanOdometry::process(const FeatureSet& f, const std::optiona
   out.iterations = r.iterations;
   Eigen::Isometry3d T = r.pose;
   Eigen::Matrix3d rotation_covariance = Eigen::Matrix3d::Zero();  // of T_ref_curr's rotation, lidar and gyro
-  if (has_previous_ && r.ok) {
+  const bool registered = has_previous_ && r.ok;
+  if (registered) {
     RegistrationConfig reported = config_.registration;
     if (held_to_measured) reported.prior_sigma_translation_m = measured->sigma_translation_m;
     reportRegistration(r.result, reported, out);
@@ -470,14 +471,14 @@ PoseEstimate ScanToScanOdometry::process(const FeatureSet& f, const std::optiona
     pose_ = reference_pose_ * T;
   }
   out.pose = pose_;
-  if (has_previous_ && r.ok) {
+  if (registered) {
     out.pose = standstill_.update(f.utime, pose_);
     if (standstill_.holding()) out.flags |= PoseEstimate::kStandingStill;
   } else {
     standstill_.reset();
   }
   // A compensated raw sweep counts as deskewed from now on (a reference kept after its compensation too).
-  reference_kept_ = has_previous_ && r.ok && keepsReference(T);
+  reference_kept_ = registered && keepsReference(T);
   if (reference_kept_) {
     ref_T_prev_ = T;
     ref_R_prev_covariance_ = rotation_covariance;

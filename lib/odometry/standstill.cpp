@@ -21,13 +21,12 @@ ConfigTable<StandstillConfig> standstillConfigTable(const std::string& prefix) {
 }
 
 StandstillHold::Sample StandstillHold::sample(std::int64_t utime, const Eigen::Isometry3d& T) const {
-  return {toSeconds(utime - window_start_), T.translation() - anchor_, logRotation(reference_.transpose() * T.linear())};
+  return {utime, T.translation() - anchor_, logRotation(reference_.transpose() * T.linear())};
 }
 
 Eigen::Isometry3d StandstillHold::update(std::int64_t utime, const Eigen::Isometry3d& registered) {
   if (config_.window_sweeps <= 0) return registered;
   if (window_.empty()) {
-    window_start_ = utime;
     anchor_ = registered.translation();
     reference_ = registered.linear();
   }
@@ -72,10 +71,12 @@ void StandstillHold::add(const Sample& s) {
 
 // The least-squares slopes of position and rotation against time over the window, each below its bound.
 bool StandstillHold::windowStill() const {
+  // Times in seconds since the window's first sample.
+  const auto seconds = [this](const Sample& s) { return toSeconds(s.utime - window_.front().utime); };
   double t_mean = 0;
   Eigen::Vector3d p_mean = Eigen::Vector3d::Zero(), r_mean = Eigen::Vector3d::Zero();
   for (const Sample& s : window_) {
-    t_mean += s.t;
+    t_mean += seconds(s);
     p_mean += s.position;
     r_mean += s.rotation;
   }
@@ -86,7 +87,7 @@ bool StandstillHold::windowStill() const {
   double tt = 0;
   Eigen::Vector3d tp = Eigen::Vector3d::Zero(), tr = Eigen::Vector3d::Zero();
   for (const Sample& s : window_) {
-    const double dt = s.t - t_mean;
+    const double dt = seconds(s) - t_mean;
     tt += dt * dt;
     tp += dt * (s.position - p_mean);
     tr += dt * (s.rotation - r_mean);

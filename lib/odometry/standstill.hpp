@@ -54,7 +54,7 @@ class StandstillHold {
 
  private:
   struct Sample {
-    double t = 0;  // s since the window's first sample
+    std::int64_t utime = 0;
     Eigen::Vector3d position, rotation;  // relative to anchor_ and to reference_ (rotation vector)
   };
   Sample sample(std::int64_t utime, const Eigen::Isometry3d& T) const;
@@ -66,7 +66,6 @@ class StandstillHold {
 
   StandstillConfig config_;
   std::deque<Sample> window_;
-  std::int64_t window_start_ = 0;
   Eigen::Vector3d anchor_ = Eigen::Vector3d::Zero();         // the window's first position
   Eigen::Matrix3d reference_ = Eigen::Matrix3d::Identity();  // and rotation
   bool holding_ = false;
