@@ -47,6 +47,16 @@ struct ImuSample {
   std::optional<Eigen::Quaterniond> orientation;    // R_world_imu
 };
 
+// The accelerometer's specific force (+9.81 up at rest) over an interval, rotated into the lidar frame at
+// its end and integrated once (a velocity change) and twice from rest at its start (a displacement): what a
+// stage with better rotations than the gyro's needs to find gravity (mapping/gravity.hpp).
+struct SpecificForceIntegral {
+  std::int64_t since_utime = -1;  // start of the interval; -1: none (no IMU, samples that do not cover it)
+  Eigen::Vector3d velocity_change = Eigen::Vector3d::Zero();  // m/s
+  Eigen::Vector3d displacement = Eigen::Vector3d::Zero();     // m
+  bool valid() const { return since_utime >= 0; }
+};
+
 struct StampedPose {
   std::int64_t utime = 0;
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();  // T_world_lidar
@@ -107,6 +117,11 @@ struct PoseEstimate {
   std::int32_t flags = 0;
   int iterations = 0;
   double final_cost = 0.0;
+  // ODOM_SCAN: the accelerometer since the previous sweep (odometry/specific_force.hpp).
+  SpecificForceIntegral specific_force;
+  // ODOM_MAPPED: gravity in the lidar frame (m/s^2, pointing down) as the accelerometer saw it with the robot's
+  // own acceleration removed (mapping/gravity.hpp); zero where unknown (no IMU, the first seconds).
+  Eigen::Vector3d gravity = Eigen::Vector3d::Zero();
 };
 
 // A verified loop closure between two keyframes.

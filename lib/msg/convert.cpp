@@ -218,6 +218,12 @@ adit::odometry_t toMessage(const PoseEstimate& pose, const FeatureSet* features)
   const double identity_position[3] = {0, 0, 0}, identity_rotation[4] = {1, 0, 0, 0};
   std::copy(identity_position, identity_position + 3, m.loop_correction_position);
   std::copy(identity_rotation, identity_rotation + 4, m.loop_correction_orientation);
+  m.imu_since_utime = pose.specific_force.since_utime;
+  for (int i = 0; i < 3; ++i) {
+    m.imu_velocity_change[i] = pose.specific_force.velocity_change[i];
+    m.imu_displacement[i] = pose.specific_force.displacement[i];
+    m.gravity[i] = pose.gravity[i];
+  }
   m.iterations = pose.iterations;
   m.final_cost = pose.final_cost;
   m.sweep_flags = 0;
@@ -255,6 +261,12 @@ PoseEstimate fromMessage(const adit::odometry_t& m) {
     p.rotation_eigenvalues[i] = m.rotation_eigenvalues[i];
   }
   p.flags = m.flags;
+  const Eigen::Vector3d gravity(m.gravity[0], m.gravity[1], m.gravity[2]);
+  if (gravity.allFinite()) p.gravity = gravity;  // non-finite: unknown
+  const Eigen::Vector3d dv(m.imu_velocity_change[0], m.imu_velocity_change[1], m.imu_velocity_change[2]);
+  const Eigen::Vector3d dp(m.imu_displacement[0], m.imu_displacement[1], m.imu_displacement[2]);
+  if (m.imu_since_utime >= 0 && m.imu_since_utime < m.header.utime && dv.allFinite() && dp.allFinite())
+    p.specific_force = {m.imu_since_utime, dv, dp};  // otherwise none
   p.iterations = m.iterations;
   p.final_cost = m.final_cost;
   return p;

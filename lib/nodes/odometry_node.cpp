@@ -11,6 +11,7 @@
 #include "odometry/initial_guess.hpp"
 #include "registration/pose_increment.hpp"
 #include "odometry/scan_to_scan.hpp"
+#include "odometry/specific_force.hpp"
 #include "odometry/wheel_motion.hpp"
 
 #include <spdlog/spdlog.h>
@@ -110,13 +111,16 @@ class OdometryNode : public runtime::Node {
     const std::int64_t previous_utime = odometry_.lastUtime();
     const std::optional<RotationPrior> gyro = gyroRotation(imu, previous_utime, features.utime);
     if (gyro) count("gyro_rotation_weighed");
-    const PoseEstimate pose = odometry_.process(
+    PoseEstimate pose = odometry_.process(
         features, guess.T_prev_curr, guess.flags,
         wheel ? std::optional<MeasuredMotion>(MeasuredMotion{wheel->T_prev_curr, wheel->sigma_translation_m}) : std::nullopt,
         gyro);
     // The step between the registrations' own poses: the reported pose may be held (standstill).
     const Eigen::Isometry3d step = before.inverse() * odometry_.pose();
     if (previous_utime >= 0) {
+      // The accelerometer for the mapper's gravity (mapping/gravity.hpp).
+      pose.specific_force = integrateSpecificForce(raw_imu, previous_utime, features.utime, step.linear().transpose(),
+                                                   guess_config_.R_lidar_imu, guess_config_.max_imu_gap_s);
       gyro_bias_.observe(raw_imu, previous_utime, features.utime, step,
                          !(pose.flags & PoseEstimate::kRegistrationFailed));
       if (gyro_bias_.known()) {

@@ -112,7 +112,10 @@ class RelocaliserNode : public runtime::Node, public WritesProducts {
     if (r.lost_now) spdlog::warn("[relocaliser] lost at {:.1f} s: relocalising", static_cast<double>(session.utime - first_utime_) * 1e-6);
     if (r.T_map_lidar) {
       in_map_.push_back({session.utime, *r.T_map_lidar});
-      adit::odometry_t out = msg::toMessage(PoseEstimate{session.utime, *r.T_map_lidar}, nullptr);
+      PoseEstimate in_map;
+      in_map.utime = session.utime;
+      in_map.pose = *r.T_map_lidar;
+      adit::odometry_t out = msg::toMessage(in_map, nullptr);
       out.header = msg::makeHeader(session.utime, "map");
       if (r.anchored_now) out.flags |= adit::odometry_t::FLAG_MAP_MEASURED;  // what an extending run ties to the map
       publish("pose", out);
