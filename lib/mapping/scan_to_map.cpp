@@ -39,6 +39,7 @@ MapperConfig aloamMapperConfig() {
   m.line_through_nearest = false;
   m.thin_within_sweep = true;
   m.standstill.window_sweeps = 0;  // every registration is the pose
+  m.gravity.time_constant_s = 0.0;  // A-LOAM's mapper knows no IMU
   return m;
 }
 
@@ -48,6 +49,7 @@ const ConfigTable<MapperConfig>& mapperConfigTable() {
     ConfigTable<M> t("mapping");
     t.nest(&M::registration, registrationConfigTable("mapping"))
      .nest(&M::standstill, standstillConfigTable("mapping.standstill"))
+     .nest(&M::gravity, gravityConfigTable("mapping.gravity"))
      .add("outer_iterations", &M::outer_iterations, between(1, 100), "", "correspondence rounds per sweep (A-LOAM: 2)")
      .add("corner_resolution_m", &M::corner_resolution_m, between(0.01, 10), "m", "resolution of edge points in the sweep and the map")
      .add("surf_resolution_m", &M::surf_resolution_m, between(0.01, 10), "m", "resolution of surface points in the sweep and the map")
@@ -85,7 +87,9 @@ ScanToMapMapper::ScanToMapMapper(MapperConfig config)
       global_map_(config_.global_map_resolution_m, static_cast<std::size_t>(config_.global_map_max_voxels)),
       pool_(config_.registration.search_threads > 1 ? std::make_shared<ChunkPool>(config_.registration.search_threads)
                                                     : nullptr),
-      standstill_(config_.standstill) {}
+      standstill_(config_.standstill),
+      gravity_observer_(config_.gravity),
+      gravity_reference_(config_.gravity) {}
 
 Correspondences ScanToMapMapper::match(const std::vector<Eigen::Vector3d>& corners,
                                        const std::vector<Eigen::Vector3d>& surfs, const Eigen::Isometry3d& T,
@@ -213,9 +217,21 @@ PoseEstimate ScanToMapMapper::process(const FeatureSet& f, const PoseEstimate& o
   }
   const bool registered = !first && !(out.flags & PoseEstimate::kRegistrationFailed);
   if (!registered) out.covariance = odometry.covariance;
+  // The map's tilt away from gravity: the local map and this sweep turn together, so registration does not
+  // pull the sweep back to the tilt the map had (gravity.hpp).
+  if (const auto level = registered ? gravity_reference_.levelling(gravity_, T, f.utime) : std::nullopt) {
+    moveLocalMap(*level);
+    T = *level * T;
+  }
   // The drift correction follows the registration, held or not: it seeds the next sweep.
   T_map_odom_ = T * odom.inverse();
   out.pose = T;
+  gravity_ = registered ? gravity_observer_.add(f.utime, T, odometry.specific_force) : std::nullopt;
+  if (!registered) gravity_observer_.reset();
+  if (gravity_) {
+    gravity_reference_.observe(*gravity_, T);
+    out.gravity = T.linear().transpose() * *gravity_;
+  }
   if (registered) {
     out.pose = standstill_.update(f.utime, T);
     if (standstill_.holding()) out.flags |= PoseEstimate::kStandingStill;
@@ -237,11 +253,17 @@ PoseEstimate ScanToMapMapper::process(const FeatureSet& f, const PoseEstimate& o
 void ScanToMapMapper::applyCorrection(const Eigen::Isometry3d& T_corrected_uncorrected) {
   if (!isFinitePose(T_corrected_uncorrected)) return;
   T_map_odom_ = T_corrected_uncorrected * T_map_odom_;
-  corner_map_.transform(T_corrected_uncorrected);
-  pending_pose_ = T_corrected_uncorrected * pending_pose_;
-  surf_map_.transform(T_corrected_uncorrected);
-  standstill_.applyCorrection(T_corrected_uncorrected);
+  moveLocalMap(T_corrected_uncorrected);
   corrected_ = true;
+}
+
+void ScanToMapMapper::moveLocalMap(const Eigen::Isometry3d& T) {
+  corner_map_.transform(T);
+  surf_map_.transform(T);
+  pending_pose_ = T * pending_pose_;
+  standstill_.applyCorrection(T);
+  gravity_observer_.applyCorrection(T);
+  if (gravity_) gravity_ = T.linear() * *gravity_;
 }
 
 ScanToMapMapper::State ScanToMapMapper::state() const {
@@ -251,6 +273,7 @@ ScanToMapMapper::State ScanToMapMapper::state() const {
   s.previous_odometry = previous_odometry_;
   s.corners = corner_map_.points();
   s.surfs = surf_map_.points();
+  s.gravity = gravity_reference_.state();
   return s;
 }
 
@@ -264,6 +287,7 @@ void ScanToMapMapper::restore(const State& s) {
   previous_utime_ = s.utime;
   corner_map_.insert(s.corners);
   surf_map_.insert(s.surfs);
+  gravity_reference_.restore(s.gravity);
 }
 
 std::vector<Eigen::Vector3f> ScanToMapMapper::globalMap(double voxel_size) const {

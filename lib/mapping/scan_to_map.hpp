@@ -7,6 +7,7 @@
 #include "core/config_table.hpp"
 #include "core/types.hpp"
 #include "mapping/global_map.hpp"
+#include "mapping/gravity.hpp"
 #include "mapping/voxel_map.hpp"
 #include "odometry/standstill.hpp"
 #include "registration/correspondences.hpp"
@@ -96,6 +97,9 @@ struct MapperConfig {
   // (odometry/standstill.hpp; keys mapping.standstill.*). Measured at rest for 60 s, noisy lidar and IMU,
   // idling chassis: see the README's "Standing still" paragraph.
   StandstillConfig standstill;
+  // Each sweep's tilt is turned towards the map's down, found from the accelerometer that ODOM_SCAN carries
+  // preintegrated and the mapper's own poses (gravity.hpp; keys mapping.gravity.*), so a long map does not bend.
+  GravityConfig gravity;
 };
 
 // Plain A-LOAM laserMapping behaviour for the ablation: no degeneracy prior, raw sweeps enter the map as they
@@ -134,6 +138,7 @@ class ScanToMapMapper {
     Eigen::Isometry3d T_map_odom = Eigen::Isometry3d::Identity();
     Eigen::Isometry3d previous_odometry = Eigen::Isometry3d::Identity();
     std::vector<Eigen::Vector3d> corners, surfs;
+    GravityReference::State gravity;
   };
   State state() const;
   // Continues from `state`: the next sweep is registered against the restored local map.
@@ -142,6 +147,9 @@ class ScanToMapMapper {
   const VoxelMap& cornerMap() const { return corner_map_; }
   const VoxelMap& surfMap() const { return surf_map_; }
   const Eigen::Isometry3d& mapFromOdometry() const { return T_map_odom_; }
+  // The map's down is known and the sweeps' tilt is corrected towards it (mapping.gravity).
+  bool holdsTiltToGravity() const { return gravity_reference_.known() && config_.gravity.time_constant_s > 0.0; }
+  int gravityRejected() const { return gravity_observer_.rejected(); }
 
  private:
   // reuse: keep a query's match from an earlier round of the same sweep while it barely moves.
@@ -167,6 +175,8 @@ class ScanToMapMapper {
   void downsample(Sweep& s) const;
   void compensate(Sweep& s, const Eigen::Isometry3d& T_prev_curr, double gap_s) const;
   void addToMaps(const Sweep& s, const Eigen::Isometry3d& T_world_lidar);
+  // The local map and what is kept in its frame move by T (a loop correction, the gravity's levelling).
+  void moveLocalMap(const Eigen::Isometry3d& T);
 
   MapperConfig config_;
   VoxelMap corner_map_;
@@ -182,6 +192,9 @@ class ScanToMapMapper {
   std::optional<Sweep> pending_;  // first raw sweep, waiting for a motion estimate
   Eigen::Isometry3d pending_pose_ = Eigen::Isometry3d::Identity();
   StandstillHold standstill_;
+  GravityObserver gravity_observer_;
+  GravityReference gravity_reference_;
+  std::optional<Eigen::Vector3d> gravity_;  // world frame, found over the sweeps so far (none: not yet, or lost)
 };
 
 }  // namespace adit

@@ -102,6 +102,8 @@ class MapperNode : public runtime::Node, public WritesProducts {
     if (mapped.flags & PoseEstimate::kDegenerateTranslation) count("degenerate_translation");
     if (mapped.flags & PoseEstimate::kDegenerateRotation) count("degenerate_rotation");
     if (mapped.flags & PoseEstimate::kStandingStill) count("standing_still");
+    if (mapper_.holdsTiltToGravity()) count("tilt_held_to_gravity");
+    if (mapper_.gravityRejected() > 0) setCount("gravity_rejected", mapper_.gravityRejected());
     adit::odometry_t out = msg::toMessage(mapped, &features);
     splitPose(applied_, out.loop_correction_position, out.loop_correction_orientation);
     publish("mapped", out);
@@ -156,6 +158,9 @@ class MapperNode : public runtime::Node, public WritesProducts {
     w.putPose(applied_);
     w.putPoints(s.corners);
     w.putPoints(s.surfs);
+    w.putMatrix(s.gravity.down_sum);
+    w.put<std::int32_t>(s.gravity.count);
+    w.putMatrix(s.gravity.R_reference);
     state_.saveLater(w.bytes());
   }
 
@@ -173,6 +178,11 @@ class MapperNode : public runtime::Node, public WritesProducts {
     const Eigen::Isometry3d applied = r.getPose();
     s.corners = r.getPoints<Eigen::Vector3d>();
     s.surfs = r.getPoints<Eigen::Vector3d>();
+    if (!r.atEnd()) {  // a checkpoint written before the map's down was kept has none
+      s.gravity.down_sum = r.getMatrix<Eigen::Vector3d>();
+      s.gravity.count = r.get<std::int32_t>();
+      s.gravity.R_reference = r.getMatrix<Eigen::Matrix3d>();
+    }
     if (!r.ok() || !r.atEnd()) return "malformed mapper state";
     mapper_.restore(s);
     applied_ = applied;
