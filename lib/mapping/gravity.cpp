@@ -18,7 +18,7 @@ ConfigTable<GravityConfig> gravityConfigTable(const std::string& prefix) {
   t.add("window_s", &G::window_s, between(0, 600), "s", "span of the registered sweeps and accelerometer integrals gravity is fitted over (0: gravity is not found)")
    .add("tolerance_mps2", &G::tolerance_mps2, above(0), "m/s^2", "a fit whose gravity is further than this from 9.80665 m/s^2 is not trusted (counted gravity_rejected)")
    .add("time_constant_s", &G::time_constant_s, atLeast(0), "s", "a tilt of the map away from the down it started with decays over this (0: the tilt is not corrected)")
-   .add("reference_sweeps", &G::reference_sweeps, between(1, 100000), "sweeps", "gravities averaged into the map's down before any sweep is held to it")
+   .add("reference_sweeps", &G::reference_sweeps, between(1, 100000), "sweeps", "gravities averaged into the map's down before the map is levelled to it")
    .add("bias_sigma_mps2", &G::bias_sigma_mps2, above(0), "m/s^2", "prior of the accelerometer's bias, estimated where the heading changes")
    .add("fit_sigma_mps2", &G::fit_sigma_mps2, above(0), "m/s^2", "weight of one gravity found in that estimate (consecutive windows share most sweeps)");
   return t;
