@@ -20,6 +20,7 @@ ConfigTable<GravityConfig> gravityConfigTable(const std::string& prefix) {
    .add("time_constant_s", &G::time_constant_s, atLeast(0), "s", "a tilt of the map away from the down it started with decays over this (0: the tilt is not corrected)")
    .add("reference_sweeps", &G::reference_sweeps, between(1, 100000), "sweeps", "gravities averaged into the map's down before the map is levelled to it")
    .add("bias_sigma_mps2", &G::bias_sigma_mps2, above(0), "m/s^2", "prior of the accelerometer's bias, estimated where the heading changes")
+   .add("max_tilt_rad", &G::max_tilt_rad, above(0), "rad", "a larger tilt between the gravity found and the map's down is not the map's drift (an accelerometer mounted otherwise than configured, or failing): not corrected, counted gravity_disagrees")
    .add("fit_sigma_mps2", &G::fit_sigma_mps2, above(0), "m/s^2", "weight of one gravity found in that estimate (consecutive windows share most sweeps)");
   return t;
 }
@@ -94,6 +95,10 @@ std::optional<Eigen::Isometry3d> GravityReference::levelling(const std::optional
   last_levelling_ = utime;
   const Eigen::Vector3d unbiased = *gravity_world - (T.linear() - R_reference_) * bias();
   const Eigen::AngleAxisd tilt(Eigen::Quaterniond::FromTwoVectors(unbiased, down()));
+  if (tilt.angle() > config_.max_tilt_rad) {
+    ++disagreements_;
+    return std::nullopt;
+  }
   const double share = std::min(1.0, config_.window_s / config_.time_constant_s);
   return Eigen::Translation3d(T.translation()) * Eigen::AngleAxisd(share * tilt.angle(), tilt.axis()) *
          Eigen::Translation3d(-T.translation());

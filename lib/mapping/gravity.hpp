@@ -50,6 +50,9 @@ struct GravityConfig {
   int reference_sweeps = 20;       // gravities averaged into the map's down before any sweep is held to it
   double bias_sigma_mps2 = 0.05;   // prior of the accelerometer's bias (the N100: ~0.03 m/s^2 per axis)
   double fit_sigma_mps2 = 0.2;     // weight of one gravity found (consecutive windows share most sweeps)
+  // A tilt larger than this is not the map's drift (hundredths of a degree a minute) but an accelerometer that
+  // is mounted otherwise than configured, or failing: no turn, counted gravity_disagrees.
+  double max_tilt_rad = 0.035;     // 2 deg
 };
 
 // Keys "<prefix>.*" ("mapping.gravity").
@@ -98,6 +101,8 @@ class GravityReference {
   void observe(const Eigen::Vector3d& gravity_world, const Eigen::Isometry3d& T_world_lidar);
   // The accelerometer's bias as estimated so far (body frame, m/s^2).
   Eigen::Vector3d bias() const;
+  // Levellings refused because the tilt exceeded max_tilt_rad.
+  int disagreements() const { return disagreements_; }
   bool known() const { return count_ >= config_.reference_sweeps && down_sum_.norm() > 0.0; }
 
   // What a restarted mapper keeps: the sum of the unit gravities (world frame) and their number.
@@ -118,6 +123,7 @@ class GravityReference {
   Eigen::Matrix3d bias_normal_ = Eigen::Matrix3d::Zero();      // bias least squares, without the prior
   Eigen::Vector3d bias_rhs_ = Eigen::Vector3d::Zero();
   std::int64_t last_levelling_ = -1;
+  int disagreements_ = 0;
 };
 
 }  // namespace adit

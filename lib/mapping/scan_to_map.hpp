@@ -150,6 +150,7 @@ class ScanToMapMapper {
   // The map's down is known and the sweeps' tilt is corrected towards it (mapping.gravity).
   bool holdsTiltToGravity() const { return gravity_reference_.known() && config_.gravity.time_constant_s > 0.0; }
   int gravityRejected() const { return gravity_observer_.rejected(); }
+  int gravityDisagreements() const { return gravity_reference_.disagreements(); }
 
  private:
   // reuse: keep a query's match from an earlier round of the same sweep while it barely moves.

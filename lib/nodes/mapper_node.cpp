@@ -104,6 +104,7 @@ class MapperNode : public runtime::Node, public WritesProducts {
     if (mapped.flags & PoseEstimate::kStandingStill) count("standing_still");
     if (mapper_.holdsTiltToGravity()) count("tilt_held_to_gravity");
     if (mapper_.gravityRejected() > 0) setCount("gravity_rejected", mapper_.gravityRejected());
+    if (mapper_.gravityDisagreements() > 0) setCount("gravity_disagrees", mapper_.gravityDisagreements());
     adit::odometry_t out = msg::toMessage(mapped, &features);
     splitPose(applied_, out.loop_correction_position, out.loop_correction_orientation);
     publish("mapped", out);

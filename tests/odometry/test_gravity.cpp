@@ -176,6 +176,11 @@ TEST(GravityReference, TurnsTheMapAShareOfItsTiltEachWindowAboutTheRobot) {
   EXPECT_NEAR((turn->linear() * tilted).normalized().dot(down.normalized()), std::cos(5.0 / 6.0 * kDeg), 1e-12);
   EXPECT_LT((*turn * about - about).norm(), 1e-12);
   EXPECT_FALSE(reference.levelling(tilted, at, toUtime(115.0)));
+  // 5 deg off is not the map's drift but an accelerometer mounted otherwise than configured: no turn, counted.
+  const Eigen::Vector3d askew = expRotation(Eigen::Vector3d(0, 5 * kDeg, 0)) * down;
+  EXPECT_FALSE(reference.levelling(askew, at, toUtime(120.0)));
+  EXPECT_EQ(reference.disagreements(), 1);
+  EXPECT_TRUE(reference.levelling(tilted, at, toUtime(130.0)));
   // Off: never a turn.
   config.time_constant_s = 0.0;
   GravityReference off(config);
