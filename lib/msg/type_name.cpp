@@ -7,6 +7,7 @@
 #include <adit/loop_closure_t.hpp>
 #include <adit/map_update_t.hpp>
 #include <adit/odometry_t.hpp>
+#include <adit/odometry_v1_t.hpp>
 #include <adit/point_cloud_t.hpp>
 #include <adit/pose_graph_t.hpp>
 #include <adit/status_t.hpp>
@@ -31,6 +32,7 @@ std::string messageTypeName(const std::uint8_t* data, std::size_t size) {
   if (hasHash<adit::wheel_odom_t>(hash)) return "wheel_odom_t";
   if (hasHash<adit::features_t>(hash)) return "features_t";
   if (hasHash<adit::odometry_t>(hash)) return "odometry_t";
+  if (hasHash<adit::odometry_v1_t>(hash)) return "odometry_v1_t";  // logs before session 31
   if (hasHash<adit::loop_closure_t>(hash)) return "loop_closure_t";
   if (hasHash<adit::pose_graph_t>(hash)) return "pose_graph_t";
   if (hasHash<adit::map_update_t>(hash)) return "map_update_t";

@@ -155,7 +155,11 @@ Validation validate(const adit::features_t& m, const InputLimits& limits) {
   return c.result();
 }
 
-Validation validate(const adit::odometry_t& m, const InputLimits& limits) {
+namespace {
+// odometry_t and its older layout share these fields (the newer's preintegration and gravity are optional:
+// non-finite ones read as none, msg/convert.cpp).
+template <class Odometry>
+Validation validateOdometry(const Odometry& m, const InputLimits& limits) {
   Check c(limits);
   c.merge(validate(m.header, limits)).position("position", m.position).quaternion("orientation", m.orientation);
   c.finite("covariance", m.covariance, 36)
@@ -167,6 +171,10 @@ Validation validate(const adit::odometry_t& m, const InputLimits& limits) {
   for (const adit::point_set_t* set : {&m.corners, &m.surfaces, &m.cloud}) c.merge(pointSet(*set, limits));
   return c.result();
 }
+}  // namespace
+
+Validation validate(const adit::odometry_t& m, const InputLimits& limits) { return validateOdometry(m, limits); }
+Validation validate(const adit::odometry_v1_t& m, const InputLimits& limits) { return validateOdometry(m, limits); }
 
 Validation validate(const adit::loop_closure_t& m, const InputLimits& limits) {
   Check c(limits);

@@ -11,6 +11,7 @@
 #include <adit/imu_t.hpp>
 #include <adit/loop_closure_t.hpp>
 #include <adit/odometry_t.hpp>
+#include <adit/odometry_v1_t.hpp>
 #include <adit/point_cloud_t.hpp>
 #include <adit/point_set_t.hpp>
 #include <adit/pose_graph_t.hpp>
@@ -47,6 +48,7 @@ Validation validate(const adit::wheel_odom_t& m, const InputLimits& limits);
 Validation validate(const adit::point_cloud_t& m, const InputLimits& limits);
 Validation validate(const adit::features_t& m, const InputLimits& limits);
 Validation validate(const adit::odometry_t& m, const InputLimits& limits);
+Validation validate(const adit::odometry_v1_t& m, const InputLimits& limits);  // older logs
 Validation validate(const adit::loop_closure_t& m, const InputLimits& limits);
 Validation validate(const adit::pose_graph_t& m, const InputLimits& limits);
 Validation validate(const adit::command_t& m, const InputLimits& limits);

@@ -8,6 +8,7 @@
 #include <adit/loop_closure_t.hpp>
 #include <adit/map_update_t.hpp>
 #include <adit/odometry_t.hpp>
+#include <adit/odometry_v1_t.hpp>
 #include <adit/pose_graph_t.hpp>
 #include <adit/status_t.hpp>
 
@@ -32,6 +33,23 @@ std::string decodeValid(const std::uint8_t* data, std::size_t size, Msg& m) {
   if (why.empty())
     if (const msg::Validation v = msg::validate(m, msg::InputLimits{})) why = v->reason;
   return why;
+}
+
+// odometry_t, or the layout of logs recorded before it carried the accelerometer's preintegration and gravity
+// (odometry_v1_t): the pose fields the viewer shows are in both.
+std::string decodeOdometry(const std::uint8_t* data, std::size_t size, adit::odometry_t& m) {
+  const std::string why = decodeValid(data, size, m);
+  if (why.empty()) return why;
+  adit::odometry_v1_t old;
+  if (!decodeValid(data, size, old).empty()) return why;
+  m = adit::odometry_t{};
+  m.header = old.header;
+  std::copy(old.position, old.position + 3, m.position);
+  std::copy(old.orientation, old.orientation + 4, m.orientation);
+  std::copy(old.loop_correction_position, old.loop_correction_position + 3, m.loop_correction_position);
+  std::copy(old.loop_correction_orientation, old.loop_correction_orientation + 4, m.loop_correction_orientation);
+  m.flags = old.flags;
+  return "";
 }
 
 bool finitePose(const Eigen::Isometry3d& T) { return T.matrix().allFinite(); }
@@ -106,7 +124,7 @@ unsigned RunDecoder::sweep(const std::uint8_t* data, std::size_t size, RunModel&
 
 unsigned RunDecoder::mapped(const std::uint8_t* data, std::size_t size, RunModel& model) {
   adit::odometry_t m;
-  if (const std::string why = decodeValid(data, size, m); !why.empty()) return refuse("ODOM_MAPPED", why);
+  if (const std::string why = decodeOdometry(data, size, m); !why.empty()) return refuse("ODOM_MAPPED", why);
   const Eigen::Isometry3d pose = makePose(m.position, m.orientation);
   const Eigen::Isometry3d correction = makePose(m.loop_correction_position, m.loop_correction_orientation);
   if (!appendPose(model.odometry, m.header.utime, correction.inverse() * pose)) {
@@ -120,7 +138,7 @@ unsigned RunDecoder::mapped(const std::uint8_t* data, std::size_t size, RunModel
 
 unsigned RunDecoder::groundTruth(const std::uint8_t* data, std::size_t size, RunModel& model) {
   adit::odometry_t m;
-  if (const std::string why = decodeValid(data, size, m); !why.empty()) return refuse("GROUND_TRUTH", why);
+  if (const std::string why = decodeOdometry(data, size, m); !why.empty()) return refuse("GROUND_TRUTH", why);
   if (!appendPose(model.ground_truth, m.header.utime, makePose(m.position, m.orientation))) {
     ++counts_.out_of_order;
     return kNoChange;

@@ -8,11 +8,13 @@
 #include "core/geometry.hpp"
 #include "mcap_walk.hpp"
 #include "msg/encode.hpp"
+#include "msg/type_name.hpp"
 
 #include <adit/imu_t.hpp>
 #include <adit/loop_closure_t.hpp>
 #include <adit/map_update_t.hpp>
 #include <adit/odometry_t.hpp>
+#include <adit/odometry_v1_t.hpp>
 #include <adit/pose_graph_t.hpp>
 #include <adit/status_t.hpp>
 #include <gtest/gtest.h>
@@ -182,6 +184,32 @@ TEST(RunModel, TrajectoriesLoopsMapAndStatusFromMessages) {
   EXPECT_EQ(decoder.counts().out_of_order, 1);
   EXPECT_EQ(decoder.counts().ignored.at("IMU"), 1);
   EXPECT_EQ(decoder.counts().used, 8);
+}
+
+// Logs recorded before odometry_t carried the accelerometer's preintegration and gravity (session 31) hold the
+// older layout on ODOM_MAPPED and GROUND_TRUTH: still read, and named by `adit info`.
+TEST(RunModel, OdometryOfOlderLogsIsStillRead) {
+  adit::odometry_v1_t old{};
+  setHeader(old.header, 5000000);
+  adit::splitPose(poseXYZYaw(3, 4, 5, 0.5), old.position, old.orientation);
+  adit::splitPose(Eigen::Isometry3d::Identity(), old.loop_correction_position, old.loop_correction_orientation);
+  for (auto* set : {&old.corners, &old.surfaces, &old.cloud}) set->scale = 0.001f;
+  const std::vector<std::uint8_t> bytes = adit::msg::encode(old);
+  EXPECT_EQ(adit::msg::messageTypeName(bytes.data(), bytes.size()), "odometry_v1_t");
+  RunModel model;
+  RunDecoder decoder;
+  decoder.apply("GROUND_TRUTH", bytes.data(), bytes.size(), model);
+  decoder.apply("ODOM_MAPPED", bytes.data(), bytes.size(), model);
+  EXPECT_EQ(decoder.counts().malformed, 0);
+  ASSERT_EQ(model.ground_truth.size(), 1u);
+  ASSERT_EQ(model.odometry.size(), 1u);
+  EXPECT_NEAR((model.odometry[0].pose.translation() - Eigen::Vector3d(3, 4, 5)).norm(), 0, 1e-9);
+  EXPECT_NEAR(adit::rotationAngle(model.ground_truth[0].pose), 0.5, 1e-9);
+  // Bytes of neither layout are still refused.
+  std::vector<std::uint8_t> garbage = bytes;
+  garbage[3] ^= 0xff;
+  decoder.apply("ODOM_MAPPED", garbage.data(), garbage.size(), model);
+  EXPECT_EQ(decoder.counts().malformed, 1);
 }
 
 TEST(FoxgloveRun, EveryTopicOfTheRunIsWrittenToMcap) {
