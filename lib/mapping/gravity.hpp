@@ -1,4 +1,4 @@
-// The map's "down", and the prior that holds each sweep's tilt to it.
+// The map's "down", and the levelling that turns the map back to it.
 //
 // Registration against the map pins a sweep's pitch and roll to the map's, but nothing pins the map's: sweeps
 // enter it at their registered poses, so a tilt error of a few thousandths of a degree a sweep accumulates and
