@@ -120,8 +120,7 @@ void GravityReference::observe(const Eigen::Vector3d& gravity_world, const Eigen
 }
 
 void GravityReference::restore(const State& s) {
-  if (!s.down_sum.allFinite() || s.count < 0) return;
-  if (!s.R_reference.allFinite()) return;
+  if (!s.down_sum.allFinite() || s.count < 0 || !s.R_reference.allFinite()) return;
   down_sum_ = s.down_sum;
   count_ = s.count;
   R_reference_ = s.R_reference;

@@ -50,7 +50,7 @@ struct GravityConfig {
   double window_s = 10.0;          // span of the sweeps gravity is fitted over; 0: gravity is not found
   double tolerance_mps2 = 1.0;     // |g| further than this from 9.80665 m/s^2: the fit is not trusted
   double time_constant_s = 240.0;  // a tilt error decays over this; 0: the tilt is not corrected
-  int reference_sweeps = 20;       // gravities averaged into the map's down before any sweep is held to it
+  int reference_sweeps = 20;       // gravities averaged into the map's down before the map is levelled to it
   double bias_sigma_mps2 = 0.05;   // prior of the accelerometer's bias (the N100: ~0.03 m/s^2 per axis)
   double fit_sigma_mps2 = 0.2;     // weight of one gravity found (consecutive windows share most sweeps)
   // A tilt larger than this is not the map's drift (hundredths of a degree a minute) but an accelerometer that
@@ -94,9 +94,10 @@ class GravityReference {
  public:
   explicit GravityReference(GravityConfig config = {}) : config_(config) {}
 
-  // The turn that takes the local map window_s / time_constant_s of the way from the gravity found (world frame)
-  // to the map's down, about `about` (the sweep's position), when window_s has passed since the last one at
-  // utime; none before the map's down is known, without a gravity, or with time_constant_s 0.
+  // The turn that takes the local map window_s / time_constant_s of the way from the gravity found (world frame,
+  // the accelerometer's bias taken out for the sweep's rotation) to the map's down, about the sweep's position,
+  // when window_s has passed since the last one at utime; none before the map's down is known, without a
+  // gravity, with time_constant_s 0, or for a tilt beyond max_tilt_rad (counted).
   std::optional<Eigen::Isometry3d> levelling(const std::optional<Eigen::Vector3d>& gravity_world,
                                              const Eigen::Isometry3d& T_world_lidar, std::int64_t utime);
   // A gravity found (world frame) over the sweeps up to one registered at T_world_lidar: the first

@@ -226,8 +226,12 @@ PoseEstimate ScanToMapMapper::process(const FeatureSet& f, const PoseEstimate& o
   // The drift correction follows the registration, held or not: it seeds the next sweep.
   T_map_odom_ = T * odom.inverse();
   out.pose = T;
-  gravity_ = registered ? gravity_observer_.add(f.utime, T, odometry.specific_force) : std::nullopt;
-  if (!registered) gravity_observer_.reset();
+  if (registered) {
+    gravity_ = gravity_observer_.add(f.utime, T, odometry.specific_force);
+  } else {  // a pose that is only the odometry's prediction starts the gravity's window again
+    gravity_observer_.reset();
+    gravity_.reset();
+  }
   if (gravity_) {
     gravity_reference_.observe(*gravity_, T);
     out.gravity = T.linear().transpose() * *gravity_;
