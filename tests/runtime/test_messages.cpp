@@ -154,7 +154,7 @@ TEST(Messages, OdometryCarriesOnlyTheSetsTheMapperNeeds) {
   EXPECT_EQ(m.corners.num_points + m.surfaces.num_points + m.cloud.num_points, 0);
   // The pose alone: what the LAN and replay's output carry (630 bytes since ODOM_SCAN carries the accelerometer
   // preintegrated and ODOM_MAPPED gravity, 56 bytes; the covariance is 288 of them).
-  EXPECT_LT(m.getEncodedSize(), 700);
+  EXPECT_LT(m.getEncodedSize(), 640);
 }
 
 TEST(Messages, OdometryRoundTripKeepsPoseAndCovariance) {
