@@ -338,12 +338,13 @@ std::vector<Eigen::Vector3f> LoopCloser::correctedMap(double voxel) const {
   for (std::size_t k = 0; k < keyframes_.size(); ++k) {
     if (clouds_.empty(static_cast<int>(k))) continue;  // a revisit: its place is in an older keyframe's cloud
     const Eigen::Isometry3f T = graph_.pose(static_cast<int>(k)).cast<float>();
-    for (const Eigen::Vector3f& p : clouds_.cloud(static_cast<int>(k)).decode()) {
-      if (grid) {
-        grid->add(T * p);
-      } else if (const Eigen::Vector3f w = T * p; w.allFinite()) {
-        points.push_back(w);
-      }
+    std::vector<Eigen::Vector3f> placed = clouds_.cloud(static_cast<int>(k)).decode();
+    for (Eigen::Vector3f& p : placed) p = T * p;
+    if (grid) {
+      grid->add(placed);
+    } else {
+      for (const Eigen::Vector3f& w : placed)
+        if (w.allFinite()) points.push_back(w);
     }
   }
   return grid ? grid->centroids() : points;

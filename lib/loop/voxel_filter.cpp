@@ -91,72 +91,127 @@ std::vector<Eigen::Vector3f> voxelDownsample(const std::vector<Eigen::Vector3f>&
 namespace {
 
 // FNV-1a over the three indices, its high bits mixed into the low ones that pick the slot.
-std::size_t hashOf(const std::array<long long, 3>& k) {
+std::uint64_t hashOf(const std::array<long long, 3>& k) {
   std::uint64_t h = 1469598103934665603ull;
   for (long long v : k) h = (h ^ static_cast<std::uint64_t>(v)) * 1099511628211ull;
-  return static_cast<std::size_t>(mixHashBits(h));
+  return mixHashBits(h);
 }
 
 }  // namespace
 
-VoxelAccumulator::VoxelAccumulator(double voxel) : voxel_(voxel), table_(1024, -1) {}
+VoxelAccumulator::VoxelAccumulator(double voxel) : voxel_(voxel), table_(1024) {}
 
-std::size_t VoxelAccumulator::slotOf(const Key& key) const {
+std::size_t VoxelAccumulator::slotOf(const Key& key, std::uint64_t hash) const {
   const std::size_t mask = table_.size() - 1;
-  std::size_t slot = hashOf(key) & mask;
-  while (table_[slot] >= 0 && cells_[static_cast<std::size_t>(table_[slot])].key != key) slot = (slot + 1) & mask;
-  return slot;
+  const auto tag = static_cast<std::uint32_t>(hash >> 32);
+  for (std::size_t slot = hash & mask;; slot = (slot + 1) & mask) {
+    const Slot& s = table_[slot];
+    if (s.index < 0) return slot;
+    if (s.tag != tag) continue;
+    const Key& k = cell(static_cast<std::size_t>(s.index)).key;
+    if (k[0] == key[0] && k[1] == key[1] && k[2] == key[2]) return slot;
+  }
 }
 
 void VoxelAccumulator::grow() {
-  table_.assign(table_.size() * 2, -1);
-  for (std::size_t i = 0; i < cells_.size(); ++i) table_[slotOf(cells_[i].key)] = static_cast<std::int32_t>(i);
+  table_.assign(table_.size() * 2, Slot{});
+  constexpr std::size_t kAhead = 16;  // the slot of voxel i + kAhead is fetched while voxel i is placed
+  std::array<std::uint64_t, kAhead> hashes{};
+  for (std::size_t i = 0; i < size_ + kAhead; ++i) {
+    std::uint64_t& hash = hashes[i % kAhead];  // voxel i - kAhead's, then voxel i's
+    if (i >= kAhead) {
+      const std::size_t v = i - kAhead;
+      table_[slotOf(cell(v).key, hash)] = {static_cast<std::uint32_t>(hash >> 32), static_cast<std::int32_t>(v)};
+    }
+    if (i < size_) {
+      hash = hashOf(cell(i).key);
+      __builtin_prefetch(&table_[hash & (table_.size() - 1)]);
+    }
+  }
+}
+
+void VoxelAccumulator::addKeyed(const Key& k, std::uint64_t hash, const Eigen::Vector3f& p) {
+  std::size_t slot = slotOf(k, hash);
+  if (table_[slot].index < 0) {
+    if (2 * (size_ + 1) > table_.size()) {
+      grow();
+      slot = slotOf(k, hash);
+    }
+    if ((size_ >> kChunkBits) == chunks_.size()) chunks_.push_back(std::make_unique<Cell[]>(std::size_t{1} << kChunkBits));
+    cell(size_).key = k;
+    table_[slot] = {static_cast<std::uint32_t>(hash >> 32), static_cast<std::int32_t>(size_)};
+    ++size_;
+  }
+  Cell& c = cell(static_cast<std::size_t>(table_[slot].index));
+  c.sum += p.cast<double>();
+  ++c.count;
 }
 
 void VoxelAccumulator::add(const Eigen::Vector3f& p) {
   Key k;
-  if (!voxelKeyOf(p, voxel_, k)) return;
-  std::size_t slot = slotOf(k);
-  if (table_[slot] < 0) {
-    if (2 * (cells_.size() + 1) > table_.size()) {
-      grow();
-      slot = slotOf(k);
+  if (voxelKeyOf(p, voxel_, k)) addKeyed(k, hashOf(k), p);
+}
+
+void VoxelAccumulator::add(const std::vector<Eigen::Vector3f>& points) {
+  // A map of millions of voxels is far beyond the caches: each point's slot and voxel are a miss each. Point
+  // i + kAhead's slot is fetched, and point i + kAhead / 2's voxel (its slot read by then), before point i is
+  // added; the points are still added one by one in order, so the sums are those of add(point).
+  constexpr std::size_t kAhead = 16;
+  struct Pending {
+    Key key;
+    std::uint64_t hash = 0;
+    bool valid = false;
+  };
+  std::array<Pending, kAhead> ring;
+  const std::size_t n = points.size();
+  for (std::size_t i = 0; i < n + kAhead; ++i) {
+    Pending& entry = ring[i % kAhead];  // point i - kAhead's, then point i's
+    if (i >= kAhead && entry.valid) addKeyed(entry.key, entry.hash, points[i - kAhead]);
+    entry.valid = i < n && voxelKeyOf(points[i], voxel_, entry.key);
+    if (entry.valid) {
+      entry.hash = hashOf(entry.key);
+      __builtin_prefetch(&table_[entry.hash & (table_.size() - 1)]);
     }
-    table_[slot] = static_cast<std::int32_t>(cells_.size());
-    cells_.push_back({k});
+    const Pending& middle = ring[(i + kAhead / 2) % kAhead];  // point i - kAhead / 2's
+    if (i >= kAhead / 2 && middle.valid) {
+      const Slot& s = table_[middle.hash & (table_.size() - 1)];
+      if (s.index >= 0 && s.tag == static_cast<std::uint32_t>(middle.hash >> 32))
+        __builtin_prefetch(&cell(static_cast<std::size_t>(s.index)));
+    }
   }
-  Cell& c = cells_[static_cast<std::size_t>(table_[slot])];
-  c.sum += p.cast<double>();
-  ++c.count;
 }
 
 std::vector<Eigen::Vector3f> VoxelAccumulator::centroids() const {
   // Voxel order: the packed key (x, y, z in 21 bits each, which orders like the key) when every voxel has
   // one, else the keys compared through the cells' indices. Keys are unique: the order is the same either way.
   std::vector<std::pair<std::uint64_t, std::uint32_t>> packed;
-  packed.reserve(cells_.size());
-  for (std::size_t i = 0; i < cells_.size(); ++i) {
+  packed.reserve(size_);
+  for (std::size_t i = 0; i < size_; ++i) {
     std::uint64_t code = 0;
-    if (!packedKey(cells_[i].key, code)) {
+    if (!packedKey(cell(i).key, code)) {
       packed = {};
       break;
     }
     packed.emplace_back(code, static_cast<std::uint32_t>(i));
   }
   std::vector<Eigen::Vector3f> out;
-  out.reserve(cells_.size());
+  out.reserve(size_);
   const auto centroid = [this, &out](std::uint32_t i) {
-    const Cell& c = cells_[i];
+    const Cell& c = cell(i);
     out.push_back((c.sum / static_cast<double>(c.count)).cast<float>());
   };
-  if (packed.size() == cells_.size()) {
+  if (packed.size() == size_) {
     std::sort(packed.begin(), packed.end());
-    for (const auto& [code, i] : packed) centroid(i);
+    constexpr std::size_t kAhead = 8;  // voxels in key order are scattered over the cells: fetch ahead
+    for (std::size_t j = 0; j < packed.size(); ++j) {
+      if (j + kAhead < packed.size()) __builtin_prefetch(&cell(packed[j + kAhead].second));
+      centroid(packed[j].second);
+    }
     return out;
   }
-  std::vector<std::uint32_t> order(cells_.size());
+  std::vector<std::uint32_t> order(size_);
   for (std::size_t i = 0; i < order.size(); ++i) order[i] = static_cast<std::uint32_t>(i);
-  std::sort(order.begin(), order.end(), [this](std::uint32_t a, std::uint32_t b) { return cells_[a].key < cells_[b].key; });
+  std::sort(order.begin(), order.end(), [this](std::uint32_t a, std::uint32_t b) { return cell(a).key < cell(b).key; });
   for (const std::uint32_t i : order) centroid(i);
   return out;
 }

@@ -509,6 +509,15 @@ TEST(VoxelAccumulator, SameCentroidsAsDownsamplingAllPointsAtOnce) {
   }
   grid.add(Eigen::Vector3f(std::nanf(""), 0.0f, 0.0f));
   EXPECT_EQ(grid.centroids(), voxelDownsample(points, 0.3));
+  // Added in batches (the table grows inside them; a NaN among them), the same sums bit for bit.
+  std::vector<Eigen::Vector3f> with_nan = points;
+  with_nan.insert(with_nan.begin() + 7, Eigen::Vector3f(0.0f, std::nanf(""), 0.0f));
+  VoxelAccumulator batched(0.3);
+  for (std::size_t begin = 0; begin < with_nan.size(); begin += 6000)
+    batched.add(std::vector<Eigen::Vector3f>(with_nan.begin() + static_cast<long>(begin),
+                                             with_nan.begin() + static_cast<long>(std::min(begin + 6000, with_nan.size()))));
+  EXPECT_GT(batched.size(), 1024u);
+  EXPECT_EQ(batched.centroids(), voxelDownsample(points, 0.3));
 }
 
 // A corrupt cloud or pose (fuzz_map_bundle: a saved map's neighbour at 1e26 m) must not make the voxel index
