@@ -2,7 +2,10 @@
 // a simulated 16-beam sweep (target <= 5 ms) and a real 64-beam KITTI sweep (target <= 25 ms).
 #include "features/feature_extractor.hpp"
 #include "features/link3d_match.hpp"
+#include "features/link3d.hpp"
+#include "features/loam_features.hpp"
 #include "features/preprocess.hpp"
+#include "features/smoothness.hpp"
 #include "io/kitti.hpp"
 #include "synthetic_scans.hpp"
 
@@ -63,6 +66,28 @@ void BM_FeatureStageKitti64Beam(benchmark::State& state) {
   state.counters["keypoints"] = static_cast<double>(keypoints);
 }
 BENCHMARK(BM_FeatureStageKitti64Beam)->Unit(benchmark::kMillisecond);
+
+// The parts of the 64-beam feature stage on one thread (kitti_mini 00, scan 0, launch/sensors/hdl64.yaml's
+// 64 rings): which part a speed-up must aim at. Arg: 0 pre-processing, 1 scoring, 2 LOAM selection, 3 LinK3D
+// clusters, 4 the sweep thinned to the maps' 0.1 m.
+void BM_FeaturePartKitti64Beam(benchmark::State& state) {
+  const io::KittiSequence seq = io::KittiSequence::open(std::string(ADIT_SHARED_DATA_DIR) + "/kitti_mini", "00");
+  const LidarScan scan = seq.scan(0);
+  FeatureConfig cfg;
+  cfg.preprocess.num_rings = 64;
+  const features::RingCloud rings = features::preprocessScan(scan, cfg.preprocess, nullptr);
+  const features::PointScores scores = features::scorePoints(rings, cfg.loam, nullptr);
+  const int part = static_cast<int>(state.range(0));
+  for (auto _ : state) {
+    if (part == 0) benchmark::DoNotOptimize(features::preprocessScan(scan, cfg.preprocess, nullptr));
+    if (part == 1) benchmark::DoNotOptimize(features::scorePoints(rings, cfg.loam, nullptr));
+    if (part == 2) benchmark::DoNotOptimize(features::selectLoamFeatures(rings, scores, cfg.loam));
+    if (part == 3) benchmark::DoNotOptimize(features::extractLinK3dClusters(rings, scores, cfg.link3d));
+    if (part == 4) benchmark::DoNotOptimize(features::voxelDownsample(rings.points, 0.1f));
+  }
+  state.counters["points"] = static_cast<double>(rings.points.size());
+}
+BENCHMARK(BM_FeaturePartKitti64Beam)->DenseRange(0, 4)->Unit(benchmark::kMicrosecond);
 
 // The feature node's thinning of the deskewed sweep to the maps' 0.1 m (FEATURES' map_cloud).
 void BM_MapCloudVoxel16Beam(benchmark::State& state) {
