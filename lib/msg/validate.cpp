@@ -156,8 +156,7 @@ Validation validate(const adit::features_t& m, const InputLimits& limits) {
 }
 
 namespace {
-// odometry_t and its older layout share these fields (the newer's preintegration and gravity are optional:
-// non-finite ones read as none, msg/convert.cpp).
+// odometry_t and its older layout share these fields.
 template <class Odometry>
 Validation validateOdometry(const Odometry& m, const InputLimits& limits) {
   Check c(limits);
@@ -173,7 +172,20 @@ Validation validateOdometry(const Odometry& m, const InputLimits& limits) {
 }
 }  // namespace
 
-Validation validate(const adit::odometry_t& m, const InputLimits& limits) { return validateOdometry(m, limits); }
+// The accelerometer's preintegration and gravity are optional, but "none" is imu_since_utime -1 and a zero
+// gravity, never a NaN or a start after the sweep: such fields come from a broken producer, and the message is
+// refused as any other non-finite field would have it.
+Validation validate(const adit::odometry_t& m, const InputLimits& limits) {
+  Check c(limits);
+  c.merge(validateOdometry(m, limits));
+  c.finite("imu_velocity_change", m.imu_velocity_change, 3)
+      .finite("imu_displacement", m.imu_displacement, 3)
+      .finite("gravity", m.gravity, 3)
+      .norm3("gravity", m.gravity, limits.max_acceleration);
+  if (m.imu_since_utime != -1)
+    c.within("imu_since_utime", static_cast<double>(m.imu_since_utime), 0.0, static_cast<double>(m.header.utime) - 1.0);
+  return c.result();
+}
 Validation validate(const adit::odometry_v1_t& m, const InputLimits& limits) { return validateOdometry(m, limits); }
 
 Validation validate(const adit::loop_closure_t& m, const InputLimits& limits) {

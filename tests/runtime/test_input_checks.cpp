@@ -247,3 +247,57 @@ TEST(InputChecks, ExtremeStampsNeverOverflowTheTimeChecks) {
   EXPECT_EQ(node.utimes.back(), top + 19 * 5 * kMs);
   EXPECT_GE(node.utimes.size(), 10u + 15u);
 }
+
+namespace {
+
+class OdometryNode : public adit::runtime::Node {
+ public:
+  OdometryNode() : Node("odometry-node") {
+    subscribe<adit::odometry_t>("odometry", "ODOM_SCAN",
+                                [this](const adit::odometry_t& m) { utimes.push_back(m.header.utime); });
+  }
+  std::vector<std::int64_t> utimes;
+};
+
+adit::odometry_t odometry(std::int64_t utime) {
+  adit::PoseEstimate p;
+  p.utime = utime;
+  p.specific_force = {utime - 100 * kMs, Eigen::Vector3d(0.1, 0, 0.98), Eigen::Vector3d(0.005, 0, 0.05)};
+  p.gravity = Eigen::Vector3d(0, 0, -9.81);
+  return adit::msg::toMessage(p, nullptr);
+}
+
+void send(OdometryNode& node, const adit::odometry_t& m) {
+  NullSink sink;
+  const Bytes b = adit::msg::encode(m);
+  node.deliver("ODOM_SCAN", b.data(), b.size(), sink);
+}
+
+}  // namespace
+
+// The accelerometer's preintegration and gravity on ODOM_SCAN / ODOM_MAPPED are optional ("none": a start of
+// -1, a zero gravity), but a NaN there, an impossible gravity or a start after the sweep is a broken producer:
+// counted and dropped like any other bad field, never read as "none" in silence.
+TEST(InputChecks, BrokenImuFieldsOfOdometryAreCountedAndDropped) {
+  OdometryNode node;
+  send(node, odometry(100 * kMs));
+  auto m = odometry(200 * kMs);
+  m.imu_velocity_change[1] = std::nan("");
+  send(node, m);
+  m = odometry(300 * kMs);
+  m.gravity[2] = -std::numeric_limits<double>::infinity();
+  send(node, m);
+  m = odometry(400 * kMs);
+  m.gravity[0] = 1e4;
+  send(node, m);
+  m = odometry(500 * kMs);
+  m.imu_since_utime = 600 * kMs;  // after the sweep it ends at
+  send(node, m);
+  m = odometry(600 * kMs);
+  m.imu_since_utime = -1;  // none: a message without an IMU part is fine
+  m.gravity[0] = m.gravity[1] = m.gravity[2] = 0.0;
+  send(node, m);
+  EXPECT_EQ(counter(node, "invalid_nonfinite"), 2);
+  EXPECT_EQ(counter(node, "invalid_range"), 2);
+  EXPECT_EQ(node.utimes, (std::vector<std::int64_t>{100 * kMs, 600 * kMs}));
+}
