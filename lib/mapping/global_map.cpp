@@ -3,29 +3,54 @@
 #include "mapping/downsample.hpp"
 
 #include <algorithm>
+#include <cstdint>
 
 namespace adit {
 
+namespace {
+constexpr std::size_t kInitialSlots = 1024;
+}  // namespace
+
 GlobalMap::GlobalMap(double resolution, std::size_t max_voxels)
-    : resolution_(resolution > 0 ? resolution : 0.1), max_voxels_(max_voxels) {}
+    : resolution_(resolution > 0 ? resolution : 0.1), max_voxels_(max_voxels), table_(kInitialSlots, -1) {}
+
+std::size_t GlobalMap::slotOf(const VoxelKey& key) const {
+  const std::size_t mask = table_.size() - 1;
+  std::size_t slot = mixedVoxelHash(key) & mask;
+  while (table_[slot] >= 0 && !(cells_[static_cast<std::size_t>(table_[slot])].key == key)) slot = (slot + 1) & mask;
+  return slot;
+}
+
+GlobalMap::Cell& GlobalMap::cellOf(const VoxelKey& key) {
+  std::size_t slot = slotOf(key);
+  if (table_[slot] >= 0) return cells_[static_cast<std::size_t>(table_[slot])];
+  if (2 * (cells_.size() + 1) > table_.size()) {
+    table_.assign(table_.size() * 2, -1);
+    for (std::size_t i = 0; i < cells_.size(); ++i) table_[slotOf(cells_[i].key)] = static_cast<std::int32_t>(i);
+    slot = slotOf(key);
+  }
+  table_[slot] = static_cast<std::int32_t>(cells_.size());
+  cells_.push_back({key});
+  return cells_.back();
+}
 
 void GlobalMap::insert(const std::vector<Eigen::Vector3f>& sweep_points, const Eigen::Isometry3d& T_world_sweep,
                        double max_range) {
   const Eigen::Isometry3f T = T_world_sweep.cast<float>();
   const float max_sq = static_cast<float>(max_range * max_range);
-  // Consecutive points of a sweep (scan order) often share a cell: reuse the last lookup (element pointers
-  // of an unordered_map stay valid across inserts).
+  // Consecutive points of a sweep (scan order) often share a cell: reuse the last lookup (an index: the
+  // array may grow).
   VoxelKey last_key;
-  Cell* last = nullptr;
+  std::size_t last = SIZE_MAX;
   for (const Eigen::Vector3f& p : sweep_points) {
     if (!p.allFinite() || p.squaredNorm() > max_sq) continue;
     const Eigen::Vector3f w = T * p;
     const VoxelKey key = voxelOf(w, resolution_);
-    if (last == nullptr || !(key == last_key)) {
-      last = &cells_[key];
+    if (last == SIZE_MAX || !(key == last_key)) {
+      last = static_cast<std::size_t>(&cellOf(key) - cells_.data());
       last_key = key;
     }
-    Cell& c = *last;
+    Cell& c = cells_[last];
     // A few samples fix the centroid; capping the count keeps the float sum exact to ~1 mm even 1 km out.
     if (c.count >= kMaxSamplesPerCell) continue;
     c.sum += w;
@@ -35,16 +60,17 @@ void GlobalMap::insert(const std::vector<Eigen::Vector3f>& sweep_points, const E
 }
 
 // Doubles the resolution: each voxel's centroid joins its parent voxel, weighted by its samples. Merged in
-// key order (not the hash table's), so the sums, and the map, do not depend on the table's layout.
+// key order (not the table's), so the sums, and the map, do not depend on the table's layout.
 void GlobalMap::coarsen() {
-  std::vector<std::pair<VoxelKey, Cell>> sorted(cells_.begin(), cells_.end());
-  std::sort(sorted.begin(), sorted.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
-  cells_.clear();
+  std::vector<Cell> sorted = std::move(cells_);
+  std::sort(sorted.begin(), sorted.end(), [](const Cell& a, const Cell& b) { return a.key < b.key; });
+  cells_ = {};
+  table_.assign(kInitialSlots, -1);
   resolution_ *= 2.0;
   ++coarsenings_;
   const auto parent = [](std::int32_t i) { return i >= 0 ? i / 2 : -((-i + 1) / 2); };  // floor(i / 2)
-  for (const auto& [key, cell] : sorted) {
-    Cell& merged = cells_[VoxelKey{parent(key.x), parent(key.y), parent(key.z)}];
+  for (const Cell& cell : sorted) {
+    Cell& merged = cellOf(VoxelKey{parent(cell.key.x), parent(cell.key.y), parent(cell.key.z)});
     merged.sum += cell.sum;
     merged.count += cell.count;
     // Keep the sum of at most kMaxSamplesPerCell samples (its float precision), as insert() does.
@@ -53,13 +79,12 @@ void GlobalMap::coarsen() {
       merged.count = kMaxSamplesPerCell;
     }
   }
-  cells_.rehash(0);  // give back the buckets of the finer grid
 }
 
 std::vector<Eigen::Vector3f> GlobalMap::points(double voxel_size) const {
   std::vector<std::pair<VoxelKey, Eigen::Vector3f>> keyed;
   keyed.reserve(cells_.size());
-  for (const auto& kv : cells_) keyed.emplace_back(kv.first, kv.second.sum / static_cast<float>(kv.second.count));
+  for (const Cell& c : cells_) keyed.emplace_back(c.key, c.sum / static_cast<float>(c.count));
   std::sort(keyed.begin(), keyed.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
   std::vector<Eigen::Vector3f> out;
   out.reserve(keyed.size());
