@@ -38,22 +38,32 @@ void GlobalMap::insert(const std::vector<Eigen::Vector3f>& sweep_points, const E
                        double max_range) {
   const Eigen::Isometry3f T = T_world_sweep.cast<float>();
   const float max_sq = static_cast<float>(max_range * max_range);
-  // Consecutive points of a sweep (scan order) often share a cell: reuse the last lookup (an index: the
-  // array may grow).
-  VoxelKey last_key;
-  std::size_t last = SIZE_MAX;
+  std::vector<Eigen::Vector3f>& placed = placed_;
+  std::vector<VoxelKey>& keys = keys_;
+  placed.clear();
+  keys.clear();
   for (const Eigen::Vector3f& p : sweep_points) {
     if (!p.allFinite() || p.squaredNorm() > max_sq) continue;
-    const Eigen::Vector3f w = T * p;
-    const VoxelKey key = voxelOf(w, resolution_);
-    if (last == SIZE_MAX || !(key == last_key)) {
-      last = static_cast<std::size_t>(&cellOf(key) - cells_.data());
-      last_key = key;
+    placed.push_back(T * p);
+    keys.push_back(voxelOf(placed.back(), resolution_));
+  }
+  // A map of a long run is far beyond the caches: the table slot of the point kAhead on, and the voxel of the
+  // point kAhead / 2 on (its slot read by then), are fetched while a point is added; the points are still
+  // added in order. Consecutive points of a sweep (scan order) often share a voxel: that lookup is reused.
+  constexpr std::size_t kAhead = 16;
+  const std::size_t n = placed.size();
+  std::size_t last = SIZE_MAX;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (i + kAhead < n) __builtin_prefetch(&table_[mixedVoxelHash(keys[i + kAhead]) & (table_.size() - 1)]);
+    if (i + kAhead / 2 < n) {
+      const std::int32_t guess = table_[mixedVoxelHash(keys[i + kAhead / 2]) & (table_.size() - 1)];
+      if (guess >= 0) __builtin_prefetch(&cells_[static_cast<std::size_t>(guess)]);
     }
+    if (last == SIZE_MAX || !(keys[i] == keys[i - 1])) last = static_cast<std::size_t>(&cellOf(keys[i]) - cells_.data());
     Cell& c = cells_[last];
     // A few samples fix the centroid; capping the count keeps the float sum exact to ~1 mm even 1 km out.
     if (c.count >= kMaxSamplesPerCell) continue;
-    c.sum += w;
+    c.sum += placed[i];
     ++c.count;
   }
   while (max_voxels_ > 0 && cells_.size() > max_voxels_) coarsen();

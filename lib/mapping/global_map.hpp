@@ -48,6 +48,8 @@ class GlobalMap {
   int coarsenings_ = 0;
   std::vector<Cell> cells_;          // in order of their first point
   std::vector<std::int32_t> table_;  // slot -> index into cells_, -1 empty
+  std::vector<Eigen::Vector3f> placed_;  // insert()'s sweep in the world and its keys (kept: no allocation a sweep)
+  std::vector<VoxelKey> keys_;
 };
 
 }  // namespace adit
