@@ -27,13 +27,11 @@ std::vector<Eigen::Vector3d> voxelDownsample(const std::vector<Eigen::Vector3d>&
   cells.reserve(points.size());
   std::size_t slots = 16;
   while (slots < 2 * points.size()) slots <<= 1;
-  const std::size_t mask = slots - 1;
   std::vector<std::int32_t> table(slots, -1);
   for (const Eigen::Vector3d& p : points) {
     if (!p.allFinite()) continue;
     const VoxelKey key = voxelOf(p, voxel_size);
-    std::size_t slot = mixedVoxelHash(key) & mask;
-    while (table[slot] >= 0 && !(cells[static_cast<std::size_t>(table[slot])].key == key)) slot = (slot + 1) & mask;
+    const std::size_t slot = voxelSlot(table, cells, key);
     if (table[slot] < 0) {
       table[slot] = static_cast<std::int32_t>(cells.size());
       cells.push_back({key});

@@ -14,20 +14,14 @@ constexpr std::size_t kInitialSlots = 1024;
 GlobalMap::GlobalMap(double resolution, std::size_t max_voxels)
     : resolution_(resolution > 0 ? resolution : 0.1), max_voxels_(max_voxels), table_(kInitialSlots, -1) {}
 
-std::size_t GlobalMap::slotOf(const VoxelKey& key) const {
-  const std::size_t mask = table_.size() - 1;
-  std::size_t slot = mixedVoxelHash(key) & mask;
-  while (table_[slot] >= 0 && !(cells_[static_cast<std::size_t>(table_[slot])].key == key)) slot = (slot + 1) & mask;
-  return slot;
-}
-
 GlobalMap::Cell& GlobalMap::cellOf(const VoxelKey& key) {
-  std::size_t slot = slotOf(key);
+  std::size_t slot = voxelSlot(table_, cells_, key);
   if (table_[slot] >= 0) return cells_[static_cast<std::size_t>(table_[slot])];
   if (2 * (cells_.size() + 1) > table_.size()) {
     table_.assign(table_.size() * 2, -1);
-    for (std::size_t i = 0; i < cells_.size(); ++i) table_[slotOf(cells_[i].key)] = static_cast<std::int32_t>(i);
-    slot = slotOf(key);
+    for (std::size_t i = 0; i < cells_.size(); ++i)
+      table_[voxelSlot(table_, cells_, cells_[i].key)] = static_cast<std::int32_t>(i);
+    slot = voxelSlot(table_, cells_, key);
   }
   table_[slot] = static_cast<std::int32_t>(cells_.size());
   cells_.push_back({key});

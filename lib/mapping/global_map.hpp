@@ -40,7 +40,6 @@ class GlobalMap {
     std::int32_t count = 0;
   };
   Cell& cellOf(const VoxelKey& key);  // found, or added empty
-  std::size_t slotOf(const VoxelKey& key) const;  // the key's slot, or the empty slot where it would go
   void coarsen();
   static constexpr std::int32_t kMaxSamplesPerCell = 16;
   double resolution_;

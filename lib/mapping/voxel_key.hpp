@@ -9,6 +9,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <tuple>
+#include <vector>
 
 namespace adit {
 
@@ -30,6 +31,17 @@ struct VoxelKeyHash {
 // The spatial hash mixed so that its low bits, which pick a slot of an open-addressing table, depend on
 // every bit of the key.
 inline std::size_t mixedVoxelHash(const VoxelKey& key) { return static_cast<std::size_t>(mixHashBits(VoxelKeyHash{}(key))); }
+
+// The open-addressing tables of the mapper's voxel grids (local map, global map, thinning): a power-of-two
+// table of indices into `cells` (each with a `key`), -1 empty, linear probing. The slot holding key, or the
+// empty slot where it would go.
+template <class Cells>
+std::size_t voxelSlot(const std::vector<std::int32_t>& table, const Cells& cells, const VoxelKey& key) {
+  const std::size_t mask = table.size() - 1;
+  std::size_t slot = mixedVoxelHash(key) & mask;
+  while (table[slot] >= 0 && !(cells[static_cast<std::size_t>(table[slot])].key == key)) slot = (slot + 1) & mask;
+  return slot;
+}
 
 // Voxel index of one coordinate, clamped so that the cast cannot overflow (a tiny voxel or a far point; a
 // NaN lands in voxel 0) and a neighbour index (+-1) still fits in 32 bits.

@@ -15,12 +15,7 @@ VoxelMap::VoxelMap(double voxel_size, double min_spacing, int max_points_per_vox
       max_points_per_voxel_(std::max(1, max_points_per_voxel)),
       table_(kInitialSlots, kEmpty) {}
 
-std::size_t VoxelMap::slotOf(const VoxelKey& key) const {
-  const std::size_t mask = table_.size() - 1;
-  std::size_t slot = mixedVoxelHash(key) & mask;
-  while (table_[slot] != kEmpty && !(voxels_[static_cast<std::size_t>(table_[slot])].key == key)) slot = (slot + 1) & mask;
-  return slot;
-}
+std::size_t VoxelMap::slotOf(const VoxelKey& key) const { return voxelSlot(table_, voxels_, key); }
 
 const VoxelMap::Voxel* VoxelMap::find(const VoxelKey& key) const {
   const std::int32_t index = table_[slotOf(key)];
