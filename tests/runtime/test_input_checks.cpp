@@ -7,6 +7,8 @@
 
 #include <cmath>
 #include <limits>
+#include <string>
+#include <utility>
 
 using adit::runtime::Bytes;
 
@@ -163,13 +165,26 @@ TEST(InputChecks, OversizedCountsAreCountedSeparately) {
 
 namespace {
 
-class WheelNode : public adit::runtime::Node {
+// A node that keeps the stamps of what one channel delivered to its stage.
+template <class Msg>
+class StampRecorder : public adit::runtime::Node {
  public:
-  WheelNode() : Node("wheel-node") {
-    subscribe<adit::wheel_odom_t>("wheel", "WHEEL_ODOM",
-                                  [this](const adit::wheel_odom_t& m) { utimes.push_back(m.header.utime); });
+  StampRecorder(const std::string& name, std::string channel) : Node(name), channel_(std::move(channel)) {
+    subscribe<Msg>("input", channel_, [this](const Msg& m) { utimes.push_back(m.header.utime); });
+  }
+  void send(const Msg& m) {
+    NullSink sink;
+    const Bytes b = adit::msg::encode(m);
+    deliver(channel_, b.data(), b.size(), sink);
   }
   std::vector<std::int64_t> utimes;
+
+ private:
+  std::string channel_;
+};
+
+struct WheelNode : StampRecorder<adit::wheel_odom_t> {
+  WheelNode() : StampRecorder("wheel-node", "WHEEL_ODOM") {}
 };
 
 adit::wheel_odom_t wheel(std::int64_t utime, double speed = 1.0) {
@@ -179,10 +194,9 @@ adit::wheel_odom_t wheel(std::int64_t utime, double speed = 1.0) {
   return adit::msg::toMessage(s);
 }
 
-void send(WheelNode& node, const adit::wheel_odom_t& m) {
-  NullSink sink;
-  const Bytes b = adit::msg::encode(m);
-  node.deliver("WHEEL_ODOM", b.data(), b.size(), sink);
+template <class Msg>
+void send(StampRecorder<Msg>& node, const Msg& m) {
+  node.send(m);
 }
 
 }  // namespace
@@ -250,13 +264,8 @@ TEST(InputChecks, ExtremeStampsNeverOverflowTheTimeChecks) {
 
 namespace {
 
-class OdometryNode : public adit::runtime::Node {
- public:
-  OdometryNode() : Node("odometry-node") {
-    subscribe<adit::odometry_t>("odometry", "ODOM_SCAN",
-                                [this](const adit::odometry_t& m) { utimes.push_back(m.header.utime); });
-  }
-  std::vector<std::int64_t> utimes;
+struct OdometryNode : StampRecorder<adit::odometry_t> {
+  OdometryNode() : StampRecorder("odometry-node", "ODOM_SCAN") {}
 };
 
 adit::odometry_t odometry(std::int64_t utime) {
@@ -265,12 +274,6 @@ adit::odometry_t odometry(std::int64_t utime) {
   p.specific_force = {utime - 100 * kMs, Eigen::Vector3d(0.1, 0, 0.98), Eigen::Vector3d(0.005, 0, 0.05)};
   p.gravity = Eigen::Vector3d(0, 0, -9.81);
   return adit::msg::toMessage(p, nullptr);
-}
-
-void send(OdometryNode& node, const adit::odometry_t& m) {
-  NullSink sink;
-  const Bytes b = adit::msg::encode(m);
-  node.deliver("ODOM_SCAN", b.data(), b.size(), sink);
 }
 
 }  // namespace
