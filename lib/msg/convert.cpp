@@ -261,8 +261,9 @@ PoseEstimate fromMessage(const adit::odometry_t& m) {
     p.rotation_eigenvalues[i] = m.rotation_eigenvalues[i];
   }
   p.flags = m.flags;
+  // validate() refuses a non-finite IMU part on the bus; a caller without it still gets none, never a NaN.
   const Eigen::Vector3d gravity(m.gravity[0], m.gravity[1], m.gravity[2]);
-  if (gravity.allFinite()) p.gravity = gravity;  // non-finite: unknown
+  if (gravity.allFinite()) p.gravity = gravity;
   const Eigen::Vector3d dv(m.imu_velocity_change[0], m.imu_velocity_change[1], m.imu_velocity_change[2]);
   const Eigen::Vector3d dp(m.imu_displacement[0], m.imu_displacement[1], m.imu_displacement[2]);
   if (m.imu_since_utime >= 0 && m.imu_since_utime < m.header.utime && dv.allFinite() && dp.allFinite())
