@@ -61,6 +61,15 @@ bool PlaneTarget::nearest(const Eigen::Vector3d& query, double max_distance, Eig
   return true;
 }
 
+bool PlaneTarget::nearest(const Eigen::Vector3d& query, double max_distance, Eigen::Vector3d& point,
+                          Eigen::Vector3d& normal, NearestMemo& memo) const {
+  const int i = impl_->planar.nearest(query, max_distance * max_distance, memo);
+  if (i < 0) return false;
+  point = impl_->planar.point(i);
+  normal = impl_->normals[static_cast<std::size_t>(i)];
+  return true;
+}
+
 namespace {
 
 struct Linearisation {
@@ -73,15 +82,18 @@ struct Linearisation {
 };
 
 // Residual r = n . (T s - q); left perturbation T <- Exp(d) T gives dr/d(t, w) = [n, (T s) x n].
+// memos[i]: source point i's nearest-point search, kept across the iterations (the same matches, fewer
+// searches: late iterations move the points by millimetres).
 Linearisation linearise(const PlaneTarget& target, const std::vector<Eigen::Vector3d>& source,
-                        const Eigen::Isometry3d& T, double max_distance, double inlier_residual) {
+                        std::vector<NearestMemo>& memos, const Eigen::Isometry3d& T, double max_distance,
+                        double inlier_residual) {
   Linearisation lin;
   // Huber at the inlier scale: far matches pull, but not quadratically.
   const RobustKernel huber{RobustLoss::kHuber, inlier_residual};
   Eigen::Vector3d q, n;
-  for (const Eigen::Vector3d& s : source) {
-    const Eigen::Vector3d p = T * s;
-    if (!target.nearest(p, max_distance, q, n)) continue;
+  for (std::size_t i = 0; i < source.size(); ++i) {
+    const Eigen::Vector3d p = T * source[i];
+    if (!target.nearest(p, max_distance, q, n, memos[i])) continue;
     const double r = n.dot(p - q);
     const Eigen::Matrix<double, 6, 1> J = planeRowLeft(n, p).transpose();
     const double w = huber.weight(r * r);
@@ -98,10 +110,10 @@ Linearisation linearise(const PlaneTarget& target, const std::vector<Eigen::Vect
 }
 
 // Gauss-Newton at one correspondence gate; returns true when the update became small.
-bool runPhase(const PlaneTarget& target, const std::vector<Eigen::Vector3d>& source, double gate,
-              const IcpConfig& config, Eigen::Isometry3d& T, int& iterations) {
+bool runPhase(const PlaneTarget& target, const std::vector<Eigen::Vector3d>& source, std::vector<NearestMemo>& memos,
+              double gate, const IcpConfig& config, Eigen::Isometry3d& T, int& iterations) {
   for (int it = 0; it < config.max_iterations; ++it) {
-    const Linearisation lin = linearise(target, source, T, gate, config.inlier_residual);
+    const Linearisation lin = linearise(target, source, memos, T, gate, config.inlier_residual);
     ++iterations;
     if (lin.correspondences < 6) return false;
     const Eigen::Matrix<double, 6, 1> delta = -(lin.H + 1e-9 * Matrix6d::Identity()).ldlt().solve(lin.g);
@@ -129,11 +141,13 @@ IcpResult alignPointToPlane(const PlaneTarget& target, const std::vector<Eigen::
   if (src.size() < 6 || target.planarPoints() < 6 || !initial_T_target_source.matrix().allFinite()) return result;
 
   Eigen::Isometry3d T = initial_T_target_source;
-  runPhase(target, src, config.coarse_correspondence_distance, config, T, result.iterations);
-  result.converged = runPhase(target, src, config.fine_correspondence_distance, config, T, result.iterations);
+  std::vector<NearestMemo> memos(src.size());
+  runPhase(target, src, memos, config.coarse_correspondence_distance, config, T, result.iterations);
+  result.converged = runPhase(target, src, memos, config.fine_correspondence_distance, config, T, result.iterations);
   result.T_target_source = T;
 
-  const Linearisation lin = linearise(target, src, T, config.fine_correspondence_distance, config.inlier_residual);
+  const Linearisation lin =
+      linearise(target, src, memos, T, config.fine_correspondence_distance, config.inlier_residual);
   result.correspondences = lin.correspondences;
   result.inlier_ratio = static_cast<double>(lin.inliers) / static_cast<double>(src.size());
   result.rms = lin.inliers > 0 ? std::sqrt(lin.inlier_sq_sum / lin.inliers) : 0.0;

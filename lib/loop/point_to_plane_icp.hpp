@@ -4,6 +4,7 @@
 
 #include "core/types.hpp"
 #include "loop/fit_observability.hpp"
+#include "registration/kdtree.hpp"
 
 #include <memory>
 #include <vector>
@@ -50,6 +51,9 @@ class PlaneTarget {
 
   // Nearest planar point within max_distance: its position and unit normal. False if none.
   bool nearest(const Eigen::Vector3d& query, double max_distance, Eigen::Vector3d& point, Eigen::Vector3d& normal) const;
+  // The same, kept in `memo` across calls for one query that moves (see NearestMemo): the same answers.
+  bool nearest(const Eigen::Vector3d& query, double max_distance, Eigen::Vector3d& point, Eigen::Vector3d& normal,
+               NearestMemo& memo) const;
 
  private:
   struct Impl;

@@ -5,6 +5,7 @@
 #include <nanoflann.hpp>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <limits>
 
@@ -79,6 +80,38 @@ int KdTree3::nearest(const Eigen::Vector3d& query, double max_sq_distance, int e
   const Eigen::Vector3f q = query.cast<float>();
   index_->tree.findNeighbors(result, q.data(), nanoflann::SearchParams(32, 0.0f, false));
   return result.size() > 0 ? static_cast<int>(index) : -1;
+}
+
+int KdTree3::nearest(const Eigen::Vector3d& query, double max_sq_distance, NearestMemo& memo) const {
+  if (!index_ || !query.allFinite()) return -1;
+  const Eigen::Vector3f q = query.cast<float>();
+  const auto max_sq = static_cast<float>(max_sq_distance);
+  if (memo.index >= 0 && (q - memo.at).norm() < memo.reach) {
+    // Still the nearest of all points: the tree would return it if it is within the bound, else nothing.
+    const Eigen::Vector3f& p = index_->coords[static_cast<std::size_t>(memo.index)];
+    float dist = 0.0f;
+    for (int i = 0; i < 3; ++i) {  // summed as nanoflann's L2_Simple_Adaptor does
+      const float d = q[i] - p[i];
+      dist += d * d;
+    }
+    return dist < max_sq ? memo.index : -1;
+  }
+  // The two nearest: the first is the one-nearest search's (the same traversal, ties kept in the order met);
+  // the second, or the bound when there is none, bounds every other point.
+  float dists[2];
+  std::uint32_t indices[2];
+  BoundedKnn result(2, max_sq, -1, dists, indices);
+  index_->tree.findNeighbors(result, q.data(), nanoflann::SearchParams(32, 0.0f, false));
+  if (result.size() == 0) {
+    memo.index = -1;
+    return -1;
+  }
+  const float others = result.size() > 1 ? dists[1] : max_sq;
+  memo.at = q;
+  memo.index = static_cast<int>(indices[0]);
+  // 0.1 mm below the exact half gap: float distances and the move are computed to ~1e-6 m here.
+  memo.reach = 0.5f * (std::sqrt(others) - std::sqrt(dists[0])) - 1e-4f;
+  return memo.index;
 }
 
 void KdTree3::nearestK(const Eigen::Vector3d& query, int k, double max_sq_distance, std::vector<int>& out) const {

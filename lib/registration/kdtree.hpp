@@ -15,6 +15,16 @@
 
 namespace adit {
 
+// What a nearest-point search learnt about one query, so that the next search of the same query, moved a
+// little, can be answered without the tree (an ICP's later iterations move its points by millimetres). If
+// the nearest point was at distance d1 and every other at least d2, a query moved by less than (d2 - d1) / 2
+// still has that point nearest (triangle inequality): the kept answer is the tree's, not an approximation.
+struct NearestMemo {
+  Eigen::Vector3f at = Eigen::Vector3f::Zero();  // where the query was searched (float, as the tree compares)
+  int index = -1;                                // its nearest point; -1: search again
+  float reach = -1.0f;                           // a move shorter than this keeps `index` the nearest [m]
+};
+
 class KdTree3 {
  public:
   KdTree3() = default;
@@ -23,6 +33,9 @@ class KdTree3 {
   // Index (into the points given at construction) of the nearest point with squared distance below
   // max_sq_distance, skipping index `exclude`; -1 if there is none.
   int nearest(const Eigen::Vector3d& query, double max_sq_distance, int exclude = -1) const;
+  // The same answer (for a memo used with this tree only), from the memo while the query stays within its
+  // reach, else searched (the two nearest, one pass) and remembered.
+  int nearest(const Eigen::Vector3d& query, double max_sq_distance, NearestMemo& memo) const;
 
   // Indices of up to k nearest points with squared distance below max_sq_distance, nearest first, written
   // into `out` (its capacity is reused: no allocation per query in a loop).

@@ -70,5 +70,34 @@ TEST(KdTree, NearestKMatchesBruteForce) {
   }
 }
 
+// A query walked in steps of 0.1-20 mm (an ICP's late iterations) and sometimes jumped: the memo's answer is a
+// fresh search's every time, across bounds that change (an ICP's coarse then fine gate), on points 100 m from
+// the origin (float rounding); and most small steps are answered without a search.
+TEST(KdTree, NearestMemoGivesTheSearchAnswer) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(-5.0, 5.0), step(-0.02, 0.02), unit(0.0, 1.0);
+  const Eigen::Vector3d far(100.0, -80.0, 3.0);
+  std::vector<Eigen::Vector3d> pts(3000);
+  for (auto& p : pts) p = far + Eigen::Vector3d(u(rng), u(rng), 0.3 * u(rng));
+  // Exact duplicates and a point between two others at equal distances: ties must not be taken from the memo.
+  pts.push_back(pts[10]);
+  pts.push_back(pts[20]);
+  const KdTree3 tree(pts);
+  int answered = 0, steps = 0;
+  for (int walk = 0; walk < 100; ++walk) {
+    NearestMemo memo;
+    Eigen::Vector3d x = walk % 10 == 0 ? pts[walk] : far + Eigen::Vector3d(u(rng), u(rng), 0.3 * u(rng));
+    for (int s = 0; s < 40; ++s, ++steps) {
+      const double bound_sq = s < 20 ? 1.5 * 1.5 : 0.5 * 0.5;
+      const int expected = tree.nearest(x, bound_sq);
+      const Eigen::Vector3f before = memo.at;
+      ASSERT_EQ(tree.nearest(x, bound_sq, memo), expected) << "walk " << walk << " step " << s;
+      if (memo.at == before && memo.index >= 0) ++answered;
+      x += (unit(rng) < 0.05 ? 20.0 : unit(rng) < 0.5 ? 1.0 : 0.005) * Eigen::Vector3d(step(rng), step(rng), step(rng));
+    }
+  }
+  EXPECT_GT(answered, steps / 3);
+}
+
 }  // namespace
 }  // namespace adit
