@@ -53,15 +53,6 @@ PlaneTarget::~PlaneTarget() = default;
 int PlaneTarget::planarPoints() const { return static_cast<int>(impl_->planar.size()); }
 
 bool PlaneTarget::nearest(const Eigen::Vector3d& query, double max_distance, Eigen::Vector3d& point,
-                          Eigen::Vector3d& normal) const {
-  const int i = impl_->planar.nearest(query, max_distance * max_distance);
-  if (i < 0) return false;
-  point = impl_->planar.point(i);
-  normal = impl_->normals[static_cast<std::size_t>(i)];
-  return true;
-}
-
-bool PlaneTarget::nearest(const Eigen::Vector3d& query, double max_distance, Eigen::Vector3d& point,
                           Eigen::Vector3d& normal, NearestMemo& memo) const {
   const int i = impl_->planar.nearest(query, max_distance * max_distance, memo);
   if (i < 0) return false;

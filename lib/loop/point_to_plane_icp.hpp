@@ -49,9 +49,9 @@ class PlaneTarget {
   PlaneTarget& operator=(const PlaneTarget&) = delete;
   int planarPoints() const;
 
-  // Nearest planar point within max_distance: its position and unit normal. False if none.
-  bool nearest(const Eigen::Vector3d& query, double max_distance, Eigen::Vector3d& point, Eigen::Vector3d& normal) const;
-  // The same, kept in `memo` across calls for one query that moves (see NearestMemo): the same answers.
+  // Nearest planar point within max_distance: its position and unit normal; false if none. `memo` keeps the
+  // search's findings for the next call about the same query point as it moves (see NearestMemo): the
+  // answers are a fresh search's, fewer searches are made.
   bool nearest(const Eigen::Vector3d& query, double max_distance, Eigen::Vector3d& point, Eigen::Vector3d& normal,
                NearestMemo& memo) const;
 
