@@ -23,16 +23,6 @@ float stopAzimuth(float h, float bound_sq) {
   return (need + (0.5f * kPi - 1.0f) * need * need * need) * (1.0f + 1e-5f) + 1e-6f;
 }
 
-// Squared distance as nanoflann's L2_Simple_Adaptor sums it, so a ring query equals a tree query.
-float squaredDistance(const Eigen::Vector3f& a, const Eigen::Vector3f& b) {
-  float s = 0.0f;
-  for (int i = 0; i < 3; ++i) {
-    const float d = a[i] - b[i];
-    s += d * d;
-  }
-  return s;
-}
-
 }  // namespace
 
 RingIndexedCloud::RingIndexedCloud(const std::vector<LidarPoint>& points) {
@@ -117,7 +107,7 @@ int RingIndexedCloud::searchRing(const Ring& ring, const RingQuery& query, int k
     if (take_right) right = right + 1 == n ? 0 : right + 1;
     else left = left == 0 ? n - 1 : left - 1;
     const int global = ring.to_global[static_cast<std::size_t>(pos)];
-    const float dist = squaredDistance(q, ring.xyz[static_cast<std::size_t>(pos)]);
+    const float dist = treeSquaredDistance(q, ring.xyz[static_cast<std::size_t>(pos)]);
     if (!(dist < worst()) || global == exclude) continue;
     insertKBest(dist, global, k, count, dists, indices);
     if (count == k) stop = stopAzimuth(h, dists[k - 1]);

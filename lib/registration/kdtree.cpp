@@ -88,12 +88,7 @@ int KdTree3::nearest(const Eigen::Vector3d& query, double max_sq_distance, Neare
   const auto max_sq = static_cast<float>(max_sq_distance);
   if (memo.index >= 0 && (q - memo.at).norm() < memo.reach) {
     // Still the nearest of all points: the tree would return it if it is within the bound, else nothing.
-    const Eigen::Vector3f& p = index_->coords[static_cast<std::size_t>(memo.index)];
-    float dist = 0.0f;
-    for (int i = 0; i < 3; ++i) {  // summed as nanoflann's L2_Simple_Adaptor does
-      const float d = q[i] - p[i];
-      dist += d * d;
-    }
+    const float dist = treeSquaredDistance(q, index_->coords[static_cast<std::size_t>(memo.index)]);
     return dist < max_sq ? memo.index : -1;
   }
   // The two nearest: the first is the one-nearest search's (the same traversal, ties kept in the order met);

@@ -25,6 +25,18 @@ struct NearestMemo {
   float reach = -1.0f;                           // a move shorter than this keeps `index` the nearest [m]
 };
 
+// Squared distance summed as the tree sums it (nanoflann's L2_Simple_Adaptor: axis by axis, in float), so a
+// distance computed outside the tree (the odometry's ring walk, a memo's check) compares with the tree's bit
+// for bit.
+inline float treeSquaredDistance(const Eigen::Vector3f& a, const Eigen::Vector3f& b) {
+  float sum = 0.0f;
+  for (int i = 0; i < 3; ++i) {
+    const float d = a[i] - b[i];
+    sum += d * d;
+  }
+  return sum;
+}
+
 class KdTree3 {
  public:
   KdTree3() = default;
