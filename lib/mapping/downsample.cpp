@@ -30,13 +30,7 @@ std::vector<Eigen::Vector3d> voxelDownsample(const std::vector<Eigen::Vector3d>&
   std::vector<std::int32_t> table(slots, -1);
   for (const Eigen::Vector3d& p : points) {
     if (!p.allFinite()) continue;
-    const VoxelKey key = voxelOf(p, voxel_size);
-    const std::size_t slot = voxelSlot(table, cells, key);
-    if (table[slot] < 0) {
-      table[slot] = static_cast<std::int32_t>(cells.size());
-      cells.push_back({key});
-    }
-    Cell& c = cells[static_cast<std::size_t>(table[slot])];
+    Cell& c = cells[voxelFindOrAdd(table, cells, voxelOf(p, voxel_size))];
     c.sum += p;
     ++c.count;
   }

@@ -14,19 +14,7 @@ constexpr std::size_t kInitialSlots = 1024;
 GlobalMap::GlobalMap(double resolution, std::size_t max_voxels)
     : resolution_(resolution > 0 ? resolution : 0.1), max_voxels_(max_voxels), table_(kInitialSlots, -1) {}
 
-GlobalMap::Cell& GlobalMap::cellOf(const VoxelKey& key) {
-  std::size_t slot = voxelSlot(table_, cells_, key);
-  if (table_[slot] >= 0) return cells_[static_cast<std::size_t>(table_[slot])];
-  if (2 * (cells_.size() + 1) > table_.size()) {
-    table_.assign(table_.size() * 2, -1);
-    for (std::size_t i = 0; i < cells_.size(); ++i)
-      table_[voxelSlot(table_, cells_, cells_[i].key)] = static_cast<std::int32_t>(i);
-    slot = voxelSlot(table_, cells_, key);
-  }
-  table_[slot] = static_cast<std::int32_t>(cells_.size());
-  cells_.push_back({key});
-  return cells_.back();
-}
+GlobalMap::Cell& GlobalMap::cellOf(const VoxelKey& key) { return cells_[voxelFindOrAdd(table_, cells_, key)]; }
 
 void GlobalMap::insert(const std::vector<Eigen::Vector3f>& sweep_points, const Eigen::Isometry3d& T_world_sweep,
                        double max_range) {
@@ -53,7 +41,7 @@ void GlobalMap::insert(const std::vector<Eigen::Vector3f>& sweep_points, const E
       const std::int32_t guess = table_[mixedVoxelHash(keys[i + kAhead / 2]) & (table_.size() - 1)];
       if (guess >= 0) __builtin_prefetch(&cells_[static_cast<std::size_t>(guess)]);
     }
-    if (last == SIZE_MAX || !(keys[i] == keys[i - 1])) last = static_cast<std::size_t>(&cellOf(keys[i]) - cells_.data());
+    if (last == SIZE_MAX || !(keys[i] == keys[i - 1])) last = voxelFindOrAdd(table_, cells_, keys[i]);
     Cell& c = cells_[last];
     // A few samples fix the centroid; capping the count keeps the float sum exact to ~1 mm even 1 km out.
     if (c.count >= kMaxSamplesPerCell) continue;

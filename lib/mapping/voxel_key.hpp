@@ -9,6 +9,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <tuple>
+#include <utility>
 #include <vector>
 
 namespace adit {
@@ -41,6 +42,24 @@ std::size_t voxelSlot(const std::vector<std::int32_t>& table, const Cells& cells
   std::size_t slot = mixedVoxelHash(key) & mask;
   while (table[slot] >= 0 && !(cells[static_cast<std::size_t>(table[slot])].key == key)) slot = (slot + 1) & mask;
   return slot;
+}
+
+// The index of key's cell in `cells`, a cell made from the key alone appended if there is none. The table
+// doubles (and is refilled in the cells' order) before it would be more than half full.
+template <class Cell>
+std::size_t voxelFindOrAdd(std::vector<std::int32_t>& table, std::vector<Cell>& cells, const VoxelKey& key) {
+  std::size_t slot = voxelSlot(table, cells, key);
+  if (table[slot] >= 0) return static_cast<std::size_t>(table[slot]);
+  if (2 * (cells.size() + 1) > table.size()) {
+    table.assign(table.size() * 2, -1);
+    for (std::size_t i = 0; i < cells.size(); ++i) table[voxelSlot(table, cells, cells[i].key)] = static_cast<std::int32_t>(i);
+    slot = voxelSlot(table, cells, key);
+  }
+  table[slot] = static_cast<std::int32_t>(cells.size());
+  Cell cell{};
+  cell.key = key;
+  cells.push_back(std::move(cell));
+  return cells.size() - 1;
 }
 
 // Voxel index of one coordinate, clamped so that the cast cannot overflow (a tiny voxel or a far point; a

@@ -22,22 +22,7 @@ const VoxelMap::Voxel* VoxelMap::find(const VoxelKey& key) const {
   return index == kEmpty ? nullptr : &voxels_[static_cast<std::size_t>(index)];
 }
 
-VoxelMap::Voxel& VoxelMap::findOrAdd(const VoxelKey& key) {
-  std::size_t slot = slotOf(key);
-  if (table_[slot] != kEmpty) return voxels_[static_cast<std::size_t>(table_[slot])];
-  if (2 * (voxels_.size() + 1) > table_.size()) {
-    rehash(table_.size() * 2);
-    slot = slotOf(key);
-  }
-  table_[slot] = static_cast<std::int32_t>(voxels_.size());
-  voxels_.push_back({key, {}});
-  return voxels_.back();
-}
-
-void VoxelMap::rehash(std::size_t slots) {
-  table_.assign(slots, kEmpty);
-  for (std::size_t v = 0; v < voxels_.size(); ++v) table_[slotOf(voxels_[v].key)] = static_cast<std::int32_t>(v);
-}
+VoxelMap::Voxel& VoxelMap::findOrAdd(const VoxelKey& key) { return voxels_[voxelFindOrAdd(table_, voxels_, key)]; }
 
 // Linear probing's deletion without tombstones: later entries of the probe run move back into the gap when
 // their home slot does not lie between the gap and themselves.

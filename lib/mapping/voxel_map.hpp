@@ -55,7 +55,6 @@ class VoxelMap {
   Voxel& findOrAdd(const VoxelKey& key);
   std::size_t slotOf(const VoxelKey& key) const;  // the key's slot, or the empty slot where it would go
   void eraseSlot(std::size_t slot);
-  void rehash(std::size_t slots);
 
   double voxel_size_, min_spacing_sq_;
   int max_points_per_voxel_;
