@@ -76,6 +76,7 @@ LoopScheduler& LoopCloser::scheduler() {
 
 std::size_t LoopCloser::jobsInFlight() const { return scheduler_ ? scheduler_->inFlight() : 0; }
 double LoopCloser::waitedMs() const { return scheduler_ ? scheduler_->waitedMs() : 0.0; }
+double LoopCloser::workerCpuMs() const { return scheduler_ ? scheduler_->workerCpuMs() : 0.0; }
 
 LoopCloser::Result LoopCloser::process(const PoseEstimate& mapped, const LidarScan& cloud,
                                        KeyframeKeypointsPtr keypoints) {

@@ -193,9 +193,12 @@ class LoopCloser {
   Result process(const PoseEstimate& mapped, const LidarScan& cloud, KeyframeKeypointsPtr keypoints = nullptr);
   // End of input: applies every job still in flight (waiting for the worker).
   Result finish();
-  // Loop jobs posted but not applied yet, and the wall time (ms, measurement only) sweeps waited for them.
+  // Loop jobs posted but not applied yet, the wall time (ms, measurement only) sweeps waited for them, and the
+  // CPU time (ms, measurement only) the jobs took on the worker thread (0 with loop.worker_thread false, when
+  // they run inside process() and count in its thread's CPU time).
   std::size_t jobsInFlight() const;
   double waitedMs() const;
+  double workerCpuMs() const;
 
   // Per-sweep poses corrected by interpolating (in time) the corrections of the surrounding keyframes.
   Trajectory correctedTrajectory(const Trajectory& uncorrected) const;

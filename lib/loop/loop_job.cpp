@@ -1,5 +1,6 @@
 #include "loop/loop_job.hpp"
 
+#include "core/thread_cpu.hpp"
 #include "loop/loop_consensus.hpp"
 
 #include <algorithm>
@@ -293,8 +294,14 @@ LoopScheduler::LoopScheduler(const LoopCloserConfig& config, const LoopBook& boo
     : config_(config), book_(book), worker_(config.worker_thread) {}
 
 void LoopScheduler::submit(LoopJob job, std::int64_t due_utime) {
-  auto task = std::make_shared<std::packaged_task<LoopJobOutcome()>>(
-      [this, job = std::move(job)] { return runLoopJob(job, book_, config_, &targets_); });
+  auto task = std::make_shared<std::packaged_task<LoopJobOutcome()>>([this, job = std::move(job)] {
+    const double cpu0 = threadCpuMs();
+    LoopJobOutcome outcome = runLoopJob(job, book_, config_, &targets_);
+    // Added before the outcome is handed over, so take() sees every finished job's share.
+    if (worker_.threaded())
+      worker_cpu_ms_.store(worker_cpu_ms_.load(std::memory_order_relaxed) + (threadCpuMs() - cpu0), std::memory_order_relaxed);
+    return outcome;
+  });
   pending_.push_back({due_utime, task->get_future()});
   worker_.post([task] { (*task)(); });
 }

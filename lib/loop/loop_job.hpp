@@ -15,6 +15,7 @@
 #include "loop/plane_target_cache.hpp"
 #include "loop/serial_worker.hpp"
 
+#include <atomic>
 #include <deque>
 #include <future>
 #include <vector>
@@ -75,6 +76,9 @@ class LoopScheduler {
   // With no job in flight (after take(all)): the book renumbered by the loop closer (keyframes merged out).
   void replaceBook(LoopBook book) { book_ = std::move(book); }
   double waitedMs() const { return waited_ms_; }
+  // CPU time the jobs took on the worker thread (0 without one: they ran in submit(), on the caller's
+  // thread): STATUS only. Complete for every job whose outcome take() returned.
+  double workerCpuMs() const { return worker_cpu_ms_.load(std::memory_order_relaxed); }
 
  private:
   struct Pending {
@@ -88,6 +92,7 @@ class LoopScheduler {
   PlaneTargetCache targets_{4};
   std::deque<Pending> pending_;
   double waited_ms_ = 0;
+  std::atomic<double> worker_cpu_ms_{0.0};  // written by the worker only
   SerialWorker worker_;  // declared last: stopped (its jobs finished) before book_ goes
 };
 

@@ -112,6 +112,7 @@ class LoopCloserNode : public runtime::Node, public WritesProducts, public Write
   void onFinish() override {
     // Loop jobs still in flight are applied (and published) before anything is saved, live and in replay.
     if (!trajectory_.empty()) publishResult(trajectory_.back().utime, closer_.finish());
+    countLoopJobs();  // the jobs finish() waited for
     if (!state_.live()) return;  // replay writes its products itself
     saveProducts({});  // first: what the user asked for, before the stop's grace time runs out
     checkpoint();
@@ -120,6 +121,14 @@ class LoopCloserNode : public runtime::Node, public WritesProducts, public Write
   }
 
  private:
+  // Jobs in flight, the wall time sweeps waited for the loop worker and the worker's CPU time (loop
+  // verification, off the stage's own thread): STATUS only, replay's products never carry them.
+  void countLoopJobs() {
+    setCount("loop_jobs_in_flight", static_cast<std::int64_t>(closer_.jobsInFlight()));
+    setCount("loop_wait_ms", static_cast<std::int64_t>(closer_.waitedMs()));
+    setCount("loop_worker_cpu_ms", static_cast<std::int64_t>(closer_.workerCpuMs()));
+  }
+
   void onPoseInMap(const adit::odometry_t& m) {
     if (!(m.flags & adit::odometry_t::FLAG_MAP_MEASURED)) return;  // carried by odometry: ties nothing
     const PoseEstimate measured = msg::fromMessage(m);
@@ -161,9 +170,7 @@ class LoopCloserNode : public runtime::Node, public WritesProducts, public Write
     if (state_.live() && (periodic || result.graph_updated)) checkpoint();
     if (state_.live()) reportCheckpoints();
     trajectory_.release();
-    // Wall time the sweeps waited for the loop worker: STATUS only (replay's products never carry it).
-    setCount("loop_jobs_in_flight", static_cast<std::int64_t>(closer_.jobsInFlight()));
-    setCount("loop_wait_ms", static_cast<std::int64_t>(closer_.waitedMs()));
+    countLoopJobs();
     setCount("keyframes", s.keyframes);
     setCount("revisit_keyframes", s.revisit_keyframes);
     setCount("retired_keyframes", s.retired_keyframes);

@@ -6,7 +6,6 @@
 
 #include <algorithm>
 #include <chrono>
-#include <ctime>
 #include <limits>
 #include <stdexcept>
 
@@ -39,14 +38,6 @@ bool Node::isInput(const std::string& channel) const {
 void Node::advertise(const std::string& port, const std::string& default_channel) {
   channels_.emplace(port, default_channel);
   seq_.emplace(port, 0);
-}
-
-// CPU time of the calling thread in ms (CLOCK_THREAD_CPUTIME_ID): what a stage costs on a loaded machine,
-// where wall time also counts the other processes. Monitoring only.
-double threadCpuMs() {
-  timespec t{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
-  return static_cast<double>(t.tv_sec) * 1e3 + static_cast<double>(t.tv_nsec) * 1e-6;
 }
 
 void Node::deliver(const std::string& channel, const std::uint8_t* data, std::size_t size, Sink& sink) {

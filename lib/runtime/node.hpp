@@ -12,6 +12,7 @@
 //   4. time and sequence (admit()): see InputChecks.
 #pragma once
 
+#include "core/thread_cpu.hpp"
 #include "msg/encode.hpp"
 #include "msg/validate.hpp"
 #include "msg/wire_check.hpp"
@@ -73,8 +74,6 @@ class Sink {
   virtual ~Sink() = default;
   virtual void publish(const std::string& channel, const Bytes& data, std::int64_t utime) = 0;
 };
-
-double threadCpuMs();  // CPU time of the calling thread, ms (monitoring only)
 
 class Node {
  public:

@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -54,6 +55,24 @@ TEST(BenchFigures, JsonRoundTripsAndCompareFlagsOnlyRegressions) {
   // Faster is never a regression; within the tolerance neither.
   EXPECT_FALSE(change(compareFigures(before, benchFigures(report(3.0, 0.5)), 10), "feature.cpu_median_ms").regression);
   EXPECT_FALSE(change(compareFigures(before, benchFigures(report(4.3, 1.0)), 10), "feature.cpu_median_ms").regression);
+}
+
+// The loop closer's worker thread is a cost its own-thread CPU does not show: a figure of its own, per sweep,
+// only for a stage that reports one.
+TEST(BenchFigures, TheLoopWorkersCpuIsAFigureOfItsOwn) {
+  ReplayReport r = report(4.0, 1.0);
+  StageTiming loop;
+  loop.stage = "loop_closer";
+  loop.counters["loop_worker_cpu_ms"] = 250;
+  r.timing.push_back(loop);
+  const auto figures = benchFigures(r);
+  const auto named = [&](const std::string& name) {
+    return std::count_if(figures.begin(), figures.end(), [&](const BenchFigure& f) { return f.name == name; });
+  };
+  ASSERT_EQ(named("loop_closer.worker_cpu_ms_per_sweep"), 1);
+  EXPECT_EQ(named("feature.worker_cpu_ms_per_sweep"), 0);
+  const auto changes = compareFigures(figures, figures, 10);
+  EXPECT_DOUBLE_EQ(change(changes, "loop_closer.worker_cpu_ms_per_sweep").before, 2.5);  // 250 ms over 100 sweeps
 }
 
 TEST(BenchFigures, ANonBenchmarkFileIsAClearError) {
