@@ -35,6 +35,8 @@ LidarScan cloudHeader(const LidarScan& scan) {
 FeatureExtractor::FeatureExtractor(FeatureConfig cfg)
     : cfg_(std::move(cfg)), pool_(cfg_.threads > 1 ? std::make_shared<ChunkPool>(cfg_.threads) : nullptr) {}
 
+double FeatureExtractor::helperCpuMs() const { return pool_ ? pool_->workerCpuMs() : -1.0; }
+
 FeatureSet FeatureExtractor::process(const LidarScan& scan, const std::vector<ImuSample>& imu,
                                      const MotionPrior& motion, float cloud_voxel) const {
   FeatureSet out;

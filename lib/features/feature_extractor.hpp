@@ -28,6 +28,8 @@ class FeatureExtractor {
                      float cloud_voxel = 0.0f) const;
 
   const FeatureConfig& config() const { return cfg_; }
+  // CPU time (ms, monitoring only) of the features.threads beside the caller's: negative without them.
+  double helperCpuMs() const;
 
  private:
   FeatureConfig cfg_;

@@ -1,5 +1,6 @@
 #include "mapping/scan_to_map.hpp"
 
+#include "core/chunk_pool.hpp"
 #include "mapping/downsample.hpp"
 #include "registration/feature_fit.hpp"
 #include "registration/match_reuse.hpp"
@@ -90,6 +91,8 @@ ScanToMapMapper::ScanToMapMapper(MapperConfig config)
       standstill_(config_.standstill),
       gravity_observer_(config_.gravity),
       gravity_reference_(config_.gravity) {}
+
+double ScanToMapMapper::helperCpuMs() const { return pool_ ? pool_->workerCpuMs() : -1.0; }
 
 Correspondences ScanToMapMapper::match(const std::vector<Eigen::Vector3d>& corners,
                                        const std::vector<Eigen::Vector3d>& surfs, const Eigen::Isometry3d& T,

@@ -147,6 +147,8 @@ class ScanToMapMapper {
   const VoxelMap& cornerMap() const { return corner_map_; }
   const VoxelMap& surfMap() const { return surf_map_; }
   const Eigen::Isometry3d& mapFromOdometry() const { return T_map_odom_; }
+  // CPU time (ms, monitoring only) of the search threads beside the caller's: negative without them.
+  double helperCpuMs() const;
   // The map's down is known and the sweeps' tilt is corrected towards it (mapping.gravity).
   bool holdsTiltToGravity() const { return gravity_reference_.known() && config_.gravity.time_constant_s > 0.0; }
   int gravityRejected() const { return gravity_observer_.rejected(); }

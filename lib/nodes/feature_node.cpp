@@ -35,6 +35,8 @@ class FeatureNode : public runtime::Node {
     advertise("features", "FEATURES");
   }
 
+  double helperCpuMs() const override { return extractor_.helperCpuMs(); }
+
  protected:
   // No onRunFolder: nothing to recover (a few poses and IMU samples); a restart only says so on STATUS
   // (Node::useRunFolder).

@@ -107,6 +107,7 @@ class LoopCloserNode : public runtime::Node, public WritesProducts, public Write
   }
 
   std::string state() const override { return health().counters.count("restarted") ? "restarted" : "running"; }
+  double helperCpuMs() const override { return closer_.workerCpuMs(); }
 
  protected:
   void onFinish() override {
@@ -121,12 +122,11 @@ class LoopCloserNode : public runtime::Node, public WritesProducts, public Write
   }
 
  private:
-  // Jobs in flight, the wall time sweeps waited for the loop worker and the worker's CPU time (loop
-  // verification, off the stage's own thread): STATUS only, replay's products never carry them.
+  // Jobs in flight and the wall time sweeps waited for the loop worker: STATUS only, replay's products never
+  // carry them (the worker's CPU time is helper_cpu_ms, helperCpuMs()).
   void countLoopJobs() {
     setCount("loop_jobs_in_flight", static_cast<std::int64_t>(closer_.jobsInFlight()));
     setCount("loop_wait_ms", static_cast<std::int64_t>(closer_.waitedMs()));
-    setCount("loop_worker_cpu_ms", static_cast<std::int64_t>(closer_.workerCpuMs()));
   }
 
   void onPoseInMap(const adit::odometry_t& m) {

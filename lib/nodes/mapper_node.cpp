@@ -76,6 +76,7 @@ class MapperNode : public runtime::Node, public WritesProducts {
   }
 
   std::string state() const override { return health().counters.count("restarted") ? "restarted" : "running"; }
+  double helperCpuMs() const override { return mapper_.helperCpuMs(); }
 
   // Live: a sweep's time from the bus to its mapped pose, the pipeline's latency (STATUS_MAPPER counters
   // points_to_mapped_*); the process also listens to LIDAR_POINTS for the arrival stamps.

@@ -67,6 +67,7 @@ class OdometryNode : public runtime::Node {
   }
 
   std::string state() const override { return health().counters.count("restarted") ? "restarted" : "running"; }
+  double helperCpuMs() const override { return odometry_.helperCpuMs(); }
 
  protected:
   // A gap in the sweeps (the feature stage restarted, the sensor stalled): start registration over, but

@@ -2,7 +2,9 @@
 
 #include "registration/feature_fit.hpp"
 #include "registration/match_reuse.hpp"
+#include "core/chunk_pool.hpp"
 #include "core/geometry.hpp"
+#include "core/thread_cpu.hpp"
 #include "core/wheel_odom.hpp"
 #include "odometry/motion_compensation.hpp"
 #include "odometry/startup_search.hpp"
@@ -351,10 +353,22 @@ void ScanToScanOdometry::setPrevious(const SweepPoints& points, bool in_backgrou
         new PreviousIndex{RingIndexedCloud(less_sharp), RingIndexedCloud(less_flat)});
   };
   if (in_background && pool_) {
-    building_previous_ = std::async(std::launch::async, build, points.less_sharp, points.less_flat).share();
+    const auto timed_build = [build, cpu_us = background_cpu_us_](std::vector<LidarPoint> less_sharp,
+                                                                   std::vector<LidarPoint> less_flat) {
+      const double cpu0 = threadCpuMs();
+      auto index = build(std::move(less_sharp), std::move(less_flat));
+      cpu_us->fetch_add(static_cast<std::int64_t>((threadCpuMs() - cpu0) * 1e3), std::memory_order_relaxed);
+      return index;
+    };
+    building_previous_ = std::async(std::launch::async, timed_build, points.less_sharp, points.less_flat).share();
   } else {
     previous_ = build(points.less_sharp, points.less_flat);
   }
+}
+
+double ScanToScanOdometry::helperCpuMs() const {
+  if (!pool_) return -1.0;
+  return pool_->workerCpuMs() + static_cast<double>(background_cpu_us_->load(std::memory_order_relaxed)) * 1e-3;
 }
 
 void ScanToScanOdometry::awaitPrevious() const {

@@ -13,6 +13,8 @@
 #include "odometry/ring_cloud.hpp"
 #include "odometry/standstill.hpp"
 
+#include <atomic>
+#include <cstdint>
 #include <future>
 #include <memory>
 #include <optional>
@@ -197,6 +199,9 @@ class ScanToScanOdometry {
   // may be held instead: standstill).
   const Eigen::Isometry3d& pose() const { return pose_; }
   const ScanToScanConfig& config() const { return config_; }
+  // CPU time (ms, monitoring only) of the search threads beside the caller's and of the previous sweep's
+  // index builds in the background: negative without search threads.
+  double helperCpuMs() const;
   // The velocity (tangent, per second) of the last step (zero before two sweeps) and the time of the last
   // sweep: what a restart extrapolates (the last step, not the averaged velocity, which lags when the robot
   // speeds up: measured 1.1 m short over a 1.9 s restart gap while accelerating).
@@ -248,6 +253,8 @@ class ScanToScanOdometry {
   void awaitPrevious() const;
   mutable std::shared_ptr<const PreviousIndex> previous_ = std::make_shared<const PreviousIndex>();
   mutable std::shared_future<std::shared_ptr<const PreviousIndex>> building_previous_;
+  // CPU of those background builds, us (shared with a build still running when the odometry is copied).
+  std::shared_ptr<std::atomic<std::int64_t>> background_cpu_us_ = std::make_shared<std::atomic<std::int64_t>>(0);
   SweepPoints prev_points_;        // the previous sweep's features, kept to compensate them if they were raw
   bool previous_raw_ = false;      // the previous sweep was not deskewed
   bool has_previous_ = false;

@@ -9,8 +9,8 @@
 
 namespace adit::pipeline {
 
-double workerCpuMs(const StageTiming& stage) {
-  const auto it = stage.counters.find("loop_worker_cpu_ms");
+double helperCpuMs(const StageTiming& stage) {
+  const auto it = stage.counters.find("helper_cpu_ms");
   return it == stage.counters.end() ? -1.0 : static_cast<double>(it->second);
 }
 
@@ -22,8 +22,8 @@ std::vector<BenchFigure> benchFigures(const ReplayReport& r) {
     f.push_back({t.stage + ".wall_p95_ms", t.p95_ms, "ms", false});
     f.push_back({t.stage + ".cpu_median_ms", t.cpu_median_ms, "ms", false});
     f.push_back({t.stage + ".cpu_ms_per_sweep", t.cpu_total_ms / sweeps, "ms", false});
-    if (const double worker = workerCpuMs(t); worker >= 0)
-      f.push_back({t.stage + ".worker_cpu_ms_per_sweep", worker / sweeps, "ms", false});
+    if (const double helpers = helperCpuMs(t); helpers >= 0)
+      f.push_back({t.stage + ".helper_cpu_ms_per_sweep", helpers / sweeps, "ms", false});
   }
   f.push_back({"wall_ms_per_sweep", r.wall_seconds * 1e3 / sweeps, "ms", false});
   f.push_back({"process_cpu_ms_per_sweep", r.process_cpu_seconds * 1e3 / sweeps, "ms", false});

@@ -17,10 +17,10 @@ struct BenchFigure {
 };
 
 std::vector<BenchFigure> benchFigures(const ReplayReport& report);
-// CPU ms a stage's worker thread took in all (the loop closer's verification and graph jobs, its STATUS
-// counter loop_worker_cpu_ms), or a negative number for a stage without one: a cost the stage's own-thread
-// CPU does not show.
-double workerCpuMs(const StageTiming& stage);
+// CPU ms the threads working for a stage beside its own took in all (search threads, the feature stage's
+// threads, the loop closer's worker: its STATUS counter helper_cpu_ms), or a negative number for a stage
+// without such threads: a cost the stage's own-thread CPU does not show.
+double helperCpuMs(const StageTiming& stage);
 // {"input": ..., "figures": [{"name", "value", "unit", "higher_is_better"}, ...]}
 std::string benchFiguresJson(const std::vector<BenchFigure>& figures, const std::string& input);
 // Throws std::runtime_error naming the file when it cannot be read or is not such a JSON file.

@@ -62,8 +62,13 @@ void Node::deliver(const std::string& channel, const std::uint8_t* data, std::si
     health_.busy_s += ms * 1e-3;
     wall_ms_total_ += ms;
     cpu_ms_total_ += cpu_ms;
+    countHelperCpu();
     sink_ = nullptr;
   }
+}
+
+void Node::countHelperCpu() {
+  if (const double ms = helperCpuMs(); ms >= 0.0) setCount("helper_cpu_ms", static_cast<std::int64_t>(ms));
 }
 
 void Node::finish(Sink& sink) {
@@ -74,6 +79,7 @@ void Node::finish(Sink& sink) {
   } catch (const std::exception& e) {
     reportError("stage_exception", std::string("finish failed: ") + e.what());
   }
+  countHelperCpu();  // the work finish() waited for
   sink_ = nullptr;
 }
 

@@ -117,6 +117,10 @@ class Node {
   virtual LatencyProbe latencyProbe() const { return {}; }
   // A short word for STATUS ("running", "behind", ...); subclasses may refine it.
   virtual std::string state() const { return "running"; }
+  // CPU time (ms) of the threads working for this stage beside the one that calls it (search threads, the
+  // loop closer's worker), counted on STATUS as helper_cpu_ms after every input; negative: the stage has none.
+  // Monitoring only, like the stage's own CPU time.
+  virtual double helperCpuMs() const { return -1.0; }
 
   // Where this run's files go (products, checkpoints); called once before the first input. Live processes
   // pass RunFolder::live = true: a stage may then resume from its checkpoint and save on stop (onRunFolder).
@@ -165,6 +169,8 @@ class Node {
   virtual void onFinish() {}
 
  private:
+  void countHelperCpu();  // helper_cpu_ms from helperCpuMs()
+
   // A decoded, valid message waiting for its time to be confirmed.
   struct Held {
     std::int64_t utime = 0;

@@ -203,12 +203,12 @@ void registerPipelineBench(CLI::App& bench) {
     for (const auto& t : r.timing) {
       fmt::print("  {:<12} {:>10.2f} {:>10.2f} {:>10.2f} {:>10.2f} {:>10.2f}\n", t.stage, t.median_ms, t.p95_ms, t.max_ms,
                  t.cpu_median_ms, t.cpu_total_ms / sweeps);
-      if (const double worker = adit::pipeline::workerCpuMs(t); worker >= 0)
-        fmt::print("  {:<12} {:>10} {:>10} {:>10} {:>10} {:>10.2f}\n", " its worker", "", "", "", "", worker / sweeps);
+      if (const double helpers = adit::pipeline::helperCpuMs(t); helpers >= 0)
+        fmt::print("  {:<12} {:>10} {:>10} {:>10} {:>10} {:>10.2f}\n", "  + helpers", "", "", "", "", helpers / sweeps);
     }
     const double per_sweep = r.wall_seconds * 1e3 / sweeps;
-    fmt::print("  (ms; cpu = CPU time of the stage's own thread; \"its worker\": the loop closer's verification and graph "
-               "jobs on their worker thread, 0 with loop.worker_thread false, when they count in the stage's own)\n");
+    fmt::print("  (ms; cpu = CPU time of the stage's own thread; \"+ helpers\": its other threads (search threads, "
+               "features.threads, the loop closer's worker), where it has any)\n");
     fmt::print("  end to end: {:.1f} ms per sweep (incl. simulation when simulated), {:.1f} sweeps/s, {:.1f}x real time, "
                "process CPU {:.1f} ms per sweep (every thread), peak memory {:.0f} MB\n", per_sweep,
                per_sweep > 0 ? 1e3 / per_sweep : 0.0, r.wall_seconds > 0 ? r.sensor_seconds / r.wall_seconds : 0.0,

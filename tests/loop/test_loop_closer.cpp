@@ -195,7 +195,8 @@ TEST(LoopCloser, AppliesLoopJobsAtAFixedLaterSweepWhateverTheThread) {
   }
   EXPECT_TRUE(std::any_of(a.applied.begin(), a.applied.end(), [](const auto& x) { return x.first == x.second + 3; }));
   EXPECT_EQ(a.false_loops, 0);
-  // The worker's CPU time (STATUS loop_worker_cpu_ms) counts the jobs it ran; inline jobs count in the caller's.
+  // The worker's CPU time (the loop closer's STATUS helper_cpu_ms) counts the jobs it ran; inline jobs count in
+  // the caller's.
   EXPECT_GT(a.closer.workerCpuMs(), 0.0);
   EXPECT_EQ(b.closer.workerCpuMs(), 0.0);
 }

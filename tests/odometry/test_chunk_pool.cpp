@@ -4,6 +4,7 @@
 #include "mapping/scan_to_map.hpp"
 #include "odometry/scan_to_scan.hpp"
 #include "core/chunk_pool.hpp"
+#include "core/thread_cpu.hpp"
 #include "registration/match_reuse.hpp"
 #include "registration/parallel_matching.hpp"
 #include "synthetic_world.hpp"
@@ -11,10 +12,12 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <chrono>
 #include <cstring>
 #include <limits>
 #include <optional>
 #include <stdexcept>
+#include <thread>
 
 namespace adit {
 namespace {
@@ -52,6 +55,32 @@ TEST(ChunkPool, AnErrorInAChunkReachesTheCallerAndThePoolGoesOn) {
     for (std::size_t i = begin; i < end; ++i) sum += i;
   });
   EXPECT_EQ(sum.load(), 4950u);
+}
+
+// What the workers spend is counted (STATUS helper_cpu_ms), what the caller spends is not: the caller's chunk
+// waits until the other has started on the worker, which burns ~20 ms of its thread's CPU there.
+TEST(ChunkPool, CountsTheWorkersCpuTimeOnly) {
+  ChunkPool alone(1), pool(2);
+  const auto burn = [](double ms) {
+    const double until = threadCpuMs() + ms;
+    volatile double x = 0;
+    while (threadCpuMs() < until) x = x + 1;
+  };
+  alone.run(2, 2, [&](int, std::size_t, std::size_t) { burn(5); });
+  EXPECT_EQ(alone.workerCpuMs(), 0.0);
+  const std::thread::id caller = std::this_thread::get_id();
+  std::atomic<bool> worker_started{false};
+  pool.run(2, 2, [&](int, std::size_t, std::size_t) {
+    if (std::this_thread::get_id() != caller) {
+      worker_started = true;
+      burn(20);
+    }
+    while (!worker_started) std::this_thread::yield();
+  });
+  // The worker adds its share just after its last chunk: allow it a moment.
+  for (int i = 0; i < 2000 && pool.workerCpuMs() < 19.0; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  EXPECT_GE(pool.workerCpuMs(), 19.0);
+  EXPECT_LT(pool.workerCpuMs(), 1000.0);
 }
 
 TEST(ParallelMatching, JoinsChunksInQueryOrder) {

@@ -57,22 +57,22 @@ TEST(BenchFigures, JsonRoundTripsAndCompareFlagsOnlyRegressions) {
   EXPECT_FALSE(change(compareFigures(before, benchFigures(report(4.3, 1.0)), 10), "feature.cpu_median_ms").regression);
 }
 
-// The loop closer's worker thread is a cost its own-thread CPU does not show: a figure of its own, per sweep,
-// only for a stage that reports one.
-TEST(BenchFigures, TheLoopWorkersCpuIsAFigureOfItsOwn) {
+// A stage's other threads (search threads, the loop closer's worker) are a cost its own-thread CPU does not
+// show: a figure of their own, per sweep, only for a stage that reports them.
+TEST(BenchFigures, HelperThreadsCpuIsAFigureOfItsOwn) {
   ReplayReport r = report(4.0, 1.0);
   StageTiming loop;
   loop.stage = "loop_closer";
-  loop.counters["loop_worker_cpu_ms"] = 250;
+  loop.counters["helper_cpu_ms"] = 250;
   r.timing.push_back(loop);
   const auto figures = benchFigures(r);
   const auto named = [&](const std::string& name) {
     return std::count_if(figures.begin(), figures.end(), [&](const BenchFigure& f) { return f.name == name; });
   };
-  ASSERT_EQ(named("loop_closer.worker_cpu_ms_per_sweep"), 1);
-  EXPECT_EQ(named("feature.worker_cpu_ms_per_sweep"), 0);
+  ASSERT_EQ(named("loop_closer.helper_cpu_ms_per_sweep"), 1);
+  EXPECT_EQ(named("feature.helper_cpu_ms_per_sweep"), 0);
   const auto changes = compareFigures(figures, figures, 10);
-  EXPECT_DOUBLE_EQ(change(changes, "loop_closer.worker_cpu_ms_per_sweep").before, 2.5);  // 250 ms over 100 sweeps
+  EXPECT_DOUBLE_EQ(change(changes, "loop_closer.helper_cpu_ms_per_sweep").before, 2.5);  // 250 ms over 100 sweeps
 }
 
 TEST(BenchFigures, ANonBenchmarkFileIsAClearError) {

@@ -66,6 +66,26 @@ TEST(Node, PublishesWithSequenceNumbersInOrder) {
   EXPECT_EQ(node.health().outputs, 3);
 }
 
+// A stage with threads beside its own says what they cost on STATUS (helper_cpu_ms) after every input and at
+// the end; one without says nothing.
+TEST(Node, CountsItsHelperThreadsCpuWhereItHasAny) {
+  class Helped : public CopyNode {
+   public:
+    double helperCpuMs() const override { return helper_ms; }
+    double helper_ms = 12.7;
+  };
+  Helped helped;
+  CopyNode alone;
+  Collector sink;
+  deliver(helped, imuBytes(5000), sink);
+  deliver(alone, imuBytes(5000), sink);
+  EXPECT_EQ(helped.health().counters.at("helper_cpu_ms"), 12);
+  EXPECT_EQ(alone.health().counters.count("helper_cpu_ms"), 0u);
+  helped.helper_ms = 30.2;
+  helped.finish(sink);
+  EXPECT_EQ(helped.health().counters.at("helper_cpu_ms"), 30);
+}
+
 TEST(Node, UndecodableAndWrongTypeMessagesAreCountedErrors) {
   CopyNode node;
   Collector sink;
