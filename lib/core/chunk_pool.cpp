@@ -1,7 +1,5 @@
 #include "core/chunk_pool.hpp"
 
-#include "core/thread_cpu.hpp"
-
 #include <algorithm>
 
 namespace adit {
@@ -85,7 +83,7 @@ void ChunkPool::work() {
     }
     const double cpu0 = threadCpuMs();
     for (int chunk = 0; claim(seen, chunk);) runChunk(chunk);
-    worker_cpu_us_.fetch_add(static_cast<std::int64_t>((threadCpuMs() - cpu0) * 1e3), std::memory_order_relaxed);
+    worker_cpu_.add(threadCpuMs() - cpu0);
   }
 }
 

@@ -9,10 +9,10 @@
 // sweep's search). One call at a time: concurrent callers are serialised.
 #pragma once
 
-#include <atomic>
+#include "core/thread_cpu.hpp"
+
 #include <condition_variable>
 #include <cstddef>
-#include <cstdint>
 #include <exception>
 #include <functional>
 #include <mutex>
@@ -34,7 +34,7 @@ class ChunkPool {
   // CPU time the worker threads spent on calls so far (ms; monitoring only): what the caller's own CPU time
   // does not show. A worker adds its share of a call just after its last chunk, so the newest call's may be
   // missing for a moment after run() returned.
-  double workerCpuMs() const { return static_cast<double>(worker_cpu_us_.load(std::memory_order_relaxed)) * 1e-3; }
+  double workerCpuMs() const { return worker_cpu_.ms(); }
 
   // Range `chunk` of `chunks` nearly equal parts of [0, n): [begin, end).
   static std::pair<std::size_t, std::size_t> range(std::size_t n, int chunks, int chunk);
@@ -60,7 +60,7 @@ class ChunkPool {
   std::size_t generation_ = 0;
   bool stop_ = false;
   std::exception_ptr error_;
-  std::atomic<std::int64_t> worker_cpu_us_{0};
+  CpuTally worker_cpu_;
 };
 
 }  // namespace adit

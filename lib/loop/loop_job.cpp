@@ -1,6 +1,5 @@
 #include "loop/loop_job.hpp"
 
-#include "core/thread_cpu.hpp"
 #include "loop/loop_consensus.hpp"
 
 #include <algorithm>
@@ -298,8 +297,7 @@ void LoopScheduler::submit(LoopJob job, std::int64_t due_utime) {
     const double cpu0 = threadCpuMs();
     LoopJobOutcome outcome = runLoopJob(job, book_, config_, &targets_);
     // Added before the outcome is handed over, so take() sees every finished job's share.
-    if (worker_.threaded())
-      worker_cpu_ms_.store(worker_cpu_ms_.load(std::memory_order_relaxed) + (threadCpuMs() - cpu0), std::memory_order_relaxed);
+    if (worker_.threaded()) worker_cpu_.add(threadCpuMs() - cpu0);
     return outcome;
   });
   pending_.push_back({due_utime, task->get_future()});

@@ -10,12 +10,12 @@
 // sweeps' keyframes and the other stages (apply_delay_s = 0: applied in the same call, the old schedule).
 #pragma once
 
+#include "core/thread_cpu.hpp"
 #include "loop/loop_closer.hpp"
 #include "loop/place_match.hpp"
 #include "loop/plane_target_cache.hpp"
 #include "loop/serial_worker.hpp"
 
-#include <atomic>
 #include <deque>
 #include <future>
 #include <vector>
@@ -78,7 +78,7 @@ class LoopScheduler {
   double waitedMs() const { return waited_ms_; }
   // CPU time the jobs took on the worker thread (0 without one: they ran in submit(), on the caller's
   // thread): STATUS only. Complete for every job whose outcome take() returned.
-  double workerCpuMs() const { return worker_cpu_ms_.load(std::memory_order_relaxed); }
+  double workerCpuMs() const { return worker_cpu_.ms(); }
 
  private:
   struct Pending {
@@ -92,7 +92,7 @@ class LoopScheduler {
   PlaneTargetCache targets_{4};
   std::deque<Pending> pending_;
   double waited_ms_ = 0;
-  std::atomic<double> worker_cpu_ms_{0.0};  // written by the worker only
+  CpuTally worker_cpu_;
   SerialWorker worker_;  // declared last: stopped (its jobs finished) before book_ goes
 };
 

@@ -4,7 +4,6 @@
 #include "registration/match_reuse.hpp"
 #include "core/chunk_pool.hpp"
 #include "core/geometry.hpp"
-#include "core/thread_cpu.hpp"
 #include "core/wheel_odom.hpp"
 #include "odometry/motion_compensation.hpp"
 #include "odometry/startup_search.hpp"
@@ -353,11 +352,11 @@ void ScanToScanOdometry::setPrevious(const SweepPoints& points, bool in_backgrou
         new PreviousIndex{RingIndexedCloud(less_sharp), RingIndexedCloud(less_flat)});
   };
   if (in_background && pool_) {
-    const auto timed_build = [build, cpu_us = background_cpu_us_](std::vector<LidarPoint> less_sharp,
-                                                                   std::vector<LidarPoint> less_flat) {
+    const auto timed_build = [build, cpu = background_cpu_](std::vector<LidarPoint> less_sharp,
+                                                             std::vector<LidarPoint> less_flat) {
       const double cpu0 = threadCpuMs();
       auto index = build(std::move(less_sharp), std::move(less_flat));
-      cpu_us->fetch_add(static_cast<std::int64_t>((threadCpuMs() - cpu0) * 1e3), std::memory_order_relaxed);
+      cpu->add(threadCpuMs() - cpu0);
       return index;
     };
     building_previous_ = std::async(std::launch::async, timed_build, points.less_sharp, points.less_flat).share();
@@ -368,7 +367,7 @@ void ScanToScanOdometry::setPrevious(const SweepPoints& points, bool in_backgrou
 
 double ScanToScanOdometry::helperCpuMs() const {
   if (!pool_) return -1.0;
-  return pool_->workerCpuMs() + static_cast<double>(background_cpu_us_->load(std::memory_order_relaxed)) * 1e-3;
+  return pool_->workerCpuMs() + background_cpu_->ms();
 }
 
 void ScanToScanOdometry::awaitPrevious() const {

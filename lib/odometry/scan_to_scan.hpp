@@ -6,6 +6,7 @@
 #pragma once
 
 #include "core/config_table.hpp"
+#include "core/thread_cpu.hpp"
 #include "core/types.hpp"
 #include "registration/feature_fit.hpp"
 #include "registration/pose_increment.hpp"
@@ -13,8 +14,6 @@
 #include "odometry/ring_cloud.hpp"
 #include "odometry/standstill.hpp"
 
-#include <atomic>
-#include <cstdint>
 #include <future>
 #include <memory>
 #include <optional>
@@ -253,8 +252,8 @@ class ScanToScanOdometry {
   void awaitPrevious() const;
   mutable std::shared_ptr<const PreviousIndex> previous_ = std::make_shared<const PreviousIndex>();
   mutable std::shared_future<std::shared_ptr<const PreviousIndex>> building_previous_;
-  // CPU of those background builds, us (shared with a build still running when the odometry is copied).
-  std::shared_ptr<std::atomic<std::int64_t>> background_cpu_us_ = std::make_shared<std::atomic<std::int64_t>>(0);
+  // CPU of those background builds (shared with a build still running when the odometry is copied).
+  std::shared_ptr<CpuTally> background_cpu_ = std::make_shared<CpuTally>();
   SweepPoints prev_points_;        // the previous sweep's features, kept to compensate them if they were raw
   bool previous_raw_ = false;      // the previous sweep was not deskewed
   bool has_previous_ = false;
