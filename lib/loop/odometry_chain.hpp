@@ -38,7 +38,7 @@ double loopChi2(const Eigen::Isometry3d& Z, const Eigen::Isometry3d& T_match_que
 // within max_fit_distance of the match keyframe, while the graph puts it graph_distance away. With
 // partial_axis_offset > 0 the fit may also be a partial loop (loop_job.cpp): free along an axis a that the graph
 // crosses by at most that offset, its residual projected off a and its covariance inflated along a, so the
-// bound holds for those too (README, "Measured speed": the derivation). loop_covariance is the full loop's.
+// bound holds for those too (docs/measurements.md, "The odometry gate before ICP": the derivation). loop_covariance is the full loop's.
 // 0 when the distances do not separate the two.
 double loopChi2LowerBound(double graph_distance, double max_fit_distance, double partial_axis_offset,
                           const Matrix6d& chain_covariance, const Matrix6d& loop_covariance);

@@ -35,7 +35,7 @@
 // levelling: observable only where the heading changes, which is where it matters. What is left of it still
 // tilts a structured map a little after turns, hence a slow time_constant_s: with 240 s the 700 s loop's APE is
 // 0.0470 m and its map as near the world as unlevelled, and the kilometre's height error 1.1 m (4.1 m
-// unlevelled); with 120 s 0.19 m, but that loop's map 16 % further from the world (README, "Gravity").
+// unlevelled); with 120 s 0.19 m, but that loop's map 16 % further from the world (docs/measurements.md, "Gravity").
 #pragma once
 
 #include "core/config_table.hpp"

@@ -59,7 +59,7 @@ struct MapperConfig {
   // fell. While the robot drives, later sweeps fill the map between the rings; at rest nothing does, and the
   // mapper's attitude stayed with the first sweep's while the chassis idled (0.15 deg RMS pitch and roll):
   // with exact sensors the estimate's pitch followed ~10 % of the truth's in the featureless world (58 mm at
-  // the lidar), 50-75 % elsewhere. With 0.1 / 10: 12 mm; the noisy rest row of the README. 64 beams: 0
+  // the lidar), 50-75 % elsewhere. With 0.1 / 10: 12 mm; the noisy rest row of docs/measurements.md. 64 beams: 0
   // (launch/sensors/hdl64.yaml): rings 0.4 deg apart, and kitti_mini 02's APE grew 6.7 % with it.
   double plane_min_spread = 0.1;
   int plane_wide_neighbours = 10;
@@ -95,7 +95,7 @@ struct MapperConfig {
   bool compensate_raw_sweeps = true;
   // A robot standing still reports the mean of its registrations and leaves the map as it is
   // (odometry/standstill.hpp; keys mapping.standstill.*). Measured at rest for 60 s, noisy lidar and IMU,
-  // idling chassis: see the README's "Standing still" paragraph.
+  // idling chassis: see docs/measurements.md, "Standing still".
   StandstillConfig standstill;
   // Each sweep's tilt is turned towards the map's down, found from the accelerometer that ODOM_SCAN carries
   // preintegrated and the mapper's own poses (gravity.hpp; keys mapping.gravity.*), so a long map does not bend.

@@ -131,7 +131,7 @@ struct ScanToScanConfig {
   // (odometry/standstill.hpp; keys odometry.standstill.*); the next sweep still registers from its own. One
   // registration against the reference errs by 6-8 mm per axis on a noisy 16-beam lidar and an idling
   // chassis, twice the mapper's, hence a looser speed bound than the mapper's (at rest the 2 s line's slope
-  // stays within ~10 mm/s): README, "Standing still".
+  // stays within ~10 mm/s): docs/measurements.md, "Standing still".
   StandstillConfig standstill = [] {
     StandstillConfig c;
     c.max_speed_mps = 0.02;

@@ -51,7 +51,7 @@ class BoundedKnn {
 
 // Points per leaf. Searches are exact, so this moves only cost: a sweep's trees are built once and queried a
 // few thousand times, and the build was the larger part (16 measured cheaper than 8 in a replay; 12 and 32 were
-// not told apart from 16 on the same machine, see README "Measured speed").
+// not told apart from 16 on the same machine, see docs/measurements.md, "Speed").
 constexpr std::size_t kLeafSize = 16;
 
 struct KdTree3::Index {

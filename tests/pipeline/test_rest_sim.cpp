@@ -6,7 +6,7 @@
 // 0.07-0.10 deg off in two worlds, not to the exact gyro's); with noise and vibration neither (21-46 mm,
 // 0.14-0.31 deg); the pipeline meets 5 mm exact in every world (edge lines through the nearest map point,
 // mapping.line_through_nearest; 6.0 mm on roadway-loop before), not noisy against the shaking truth (11-25 mm):
-// README, "Bias at rest". Once the robot has stood two seconds the mapper holds its position
+// docs/measurements.md, "Bias at rest". Once the robot has stood two seconds the mapper holds its position
 // (mapping.standstill): from then on the pipeline's estimate moves < 2 mm, noisy or not, and ODOM_SCAN
 // (odometry.standstill) < 3 mm ("Standing still").
 // The exact pipeline is held to the 5 mm; the rest to what they measure, with margin. The noisy
@@ -148,7 +148,7 @@ TEST(ScanDriftSim, RoadwayLoopScanToScanAlone) {
   // Measured 2.40 % (3.6 m over 150 m; 1.41 % and 1.82 % with seeds 2 and 3, mean 1.88 %), heading 3.3 deg
   // off at the end, with edge lines through every ring that sees the edge (two-point lines: 2.03 / 3.25 /
   // 3.69 %). Before the gyro weighed the rotation (odometry.gyro_rotation_sigma_rad): 3.12 % here, heading
-  // 22.9 deg off (11-12 deg with seeds 2 and 3). The target is 2 %: README, "Bias at rest".
+  // 22.9 deg off (11-12 deg with seeds 2 and 3). The target is 2 %: docs/measurements.md, "Bias at rest".
   EXPECT_LT(scan_error, 0.05 * distance);
   EXPECT_LT(rotationAngle(truth.inverse() * scan) * 180 / M_PI, 6.0);
 }
