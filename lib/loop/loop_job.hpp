@@ -14,7 +14,7 @@
 #include "loop/loop_closer.hpp"
 #include "loop/place_match.hpp"
 #include "loop/plane_target_cache.hpp"
-#include "loop/serial_worker.hpp"
+#include "core/serial_worker.hpp"
 
 #include <deque>
 #include <future>

@@ -103,6 +103,7 @@ ScanToScanOdometry::ScanToScanOdometry(ScanToScanConfig config)
     : config_(std::move(config)),
       pool_(config_.registration.search_threads > 1 ? std::make_shared<ChunkPool>(config_.registration.search_threads)
                                                     : nullptr),
+      index_builder_(pool_ ? std::make_shared<SerialWorker>(true) : nullptr),
       standstill_(config_.standstill) {}
 
 void ScanToScanOdometry::reset() { *this = ScanToScanOdometry(config_); }
@@ -346,20 +347,24 @@ bool ScanToScanOdometry::keepsReference(const Eigen::Isometry3d& T_ref_curr) con
 
 void ScanToScanOdometry::setPrevious(const SweepPoints& points, bool in_background) {
   prev_points_ = points;
-  building_previous_ = {};  // a build still running is waited for (its future's last owner) and dropped
-  const auto build = [](std::vector<LidarPoint> less_sharp, std::vector<LidarPoint> less_flat) {
+  building_previous_ = {};  // a build still running finishes on its thread, unused
+  const auto build = [](const std::vector<LidarPoint>& less_sharp, const std::vector<LidarPoint>& less_flat) {
     return std::shared_ptr<const PreviousIndex>(
         new PreviousIndex{RingIndexedCloud(less_sharp), RingIndexedCloud(less_flat)});
   };
-  if (in_background && pool_) {
-    const auto timed_build = [build, cpu = background_cpu_](std::vector<LidarPoint> less_sharp,
-                                                             std::vector<LidarPoint> less_flat) {
+  if (in_background && index_builder_) {
+    // The job owns copies of the points and its promise: nothing of this object is touched on the builder.
+    auto done = std::make_shared<std::promise<std::shared_ptr<const PreviousIndex>>>();
+    building_previous_ = done->get_future().share();
+    index_builder_->post([build, done, cpu = background_cpu_, less_sharp = points.less_sharp, less_flat = points.less_flat] {
       const double cpu0 = threadCpuMs();
-      auto index = build(std::move(less_sharp), std::move(less_flat));
+      try {
+        done->set_value(build(less_sharp, less_flat));
+      } catch (...) {
+        done->set_exception(std::current_exception());
+      }
       cpu->add(threadCpuMs() - cpu0);
-      return index;
-    };
-    building_previous_ = std::async(std::launch::async, timed_build, points.less_sharp, points.less_flat).share();
+    });
   } else {
     previous_ = build(points.less_sharp, points.less_flat);
   }

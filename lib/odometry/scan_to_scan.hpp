@@ -6,6 +6,7 @@
 #pragma once
 
 #include "core/config_table.hpp"
+#include "core/serial_worker.hpp"
 #include "core/thread_cpu.hpp"
 #include "core/types.hpp"
 #include "registration/feature_fit.hpp"
@@ -252,7 +253,9 @@ class ScanToScanOdometry {
   void awaitPrevious() const;
   mutable std::shared_ptr<const PreviousIndex> previous_ = std::make_shared<const PreviousIndex>();
   mutable std::shared_future<std::shared_ptr<const PreviousIndex>> building_previous_;
-  // CPU of those background builds (shared with a build still running when the odometry is copied).
+  // The thread those builds run on (with search threads only), and their CPU (shared with a build still
+  // running when the odometry is copied or reset).
+  std::shared_ptr<SerialWorker> index_builder_;
   std::shared_ptr<CpuTally> background_cpu_ = std::make_shared<CpuTally>();
   SweepPoints prev_points_;        // the previous sweep's features, kept to compensate them if they were raw
   bool previous_raw_ = false;      // the previous sweep was not deskewed

@@ -1,6 +1,7 @@
 // One worker thread that runs jobs strictly in the order they were posted, so that jobs which share state
-// (the loop closer's accepted and pending loops) see it in a fixed order whatever the thread timing. With
-// threaded = false every job runs inside post(): the same results, one thread (tests, --threads 1).
+// (the loop closer's accepted and pending loops) see it in a fixed order whatever the thread timing; started
+// once, so a job a sweep costs no thread start (the odometry's background index builds). With threaded =
+// false every job runs inside post(): the same results, one thread (tests, --threads 1).
 #pragma once
 
 #include <condition_variable>

@@ -1,4 +1,4 @@
-#include "loop/serial_worker.hpp"
+#include "core/serial_worker.hpp"
 
 namespace adit {
 
