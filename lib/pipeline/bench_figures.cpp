@@ -85,6 +85,7 @@ std::vector<FigureChange> compareFigures(const std::vector<BenchFigure>& before,
   std::vector<FigureChange> changes;
   for (const BenchFigure& a : before) {
     FigureChange c{a.name, a.unit, a.value, 0, 0, false, false};
+    c.higher_is_better = a.higher_is_better;
     const BenchFigure* b = find(after, a.name);
     if (!b) {
       c.missing = true;
@@ -93,13 +94,63 @@ std::vector<FigureChange> compareFigures(const std::vector<BenchFigure>& before,
     }
     c.after = b->value;
     c.change_pct = a.value != 0 ? (b->value - a.value) / std::abs(a.value) * 100.0 : 0.0;
+    c.change_min_pct = c.change_max_pct = c.change_pct;
     const double worse = a.higher_is_better ? -c.change_pct : c.change_pct;
     c.regression = worse > tolerance_pct;
     changes.push_back(c);
   }
   for (const BenchFigure& b : after)
-    if (!find(before, b.name)) changes.push_back({b.name, b.unit, 0, b.value, 0, false, true});
+    if (!find(before, b.name)) {
+      FigureChange c{b.name, b.unit, 0, b.value, 0, false, true};
+      c.higher_is_better = b.higher_is_better;
+      changes.push_back(c);
+    }
   return changes;
+}
+
+namespace {
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+}  // namespace
+
+std::vector<FigureChange> compareFigurePairs(const std::vector<std::vector<BenchFigure>>& before,
+                                             const std::vector<std::vector<BenchFigure>>& after, double tolerance_pct) {
+  if (before.empty() || before.size() != after.size())
+    throw std::invalid_argument(fmt::format("bench compare: {} run(s) before and {} after: pairs need as many of each",
+                                            before.size(), after.size()));
+  std::vector<std::vector<FigureChange>> pairs;
+  for (std::size_t i = 0; i < before.size(); ++i) pairs.push_back(compareFigures(before[i], after[i], tolerance_pct));
+  std::vector<FigureChange> out;
+  for (const FigureChange& first : pairs.front()) {
+    FigureChange c = first;
+    std::vector<double> befores, afters, changes;
+    for (const auto& pair : pairs) {
+      const auto it = std::find_if(pair.begin(), pair.end(), [&](const FigureChange& x) { return x.name == c.name; });
+      if (it == pair.end() || it->missing) {
+        c.missing = true;
+        break;
+      }
+      befores.push_back(it->before);
+      afters.push_back(it->after);
+      changes.push_back(it->change_pct);
+    }
+    if (!c.missing) {
+      c.before = median(befores);
+      c.after = median(afters);
+      c.change_pct = median(changes);
+      c.change_min_pct = *std::min_element(changes.begin(), changes.end());
+      c.change_max_pct = *std::max_element(changes.begin(), changes.end());
+      const double worse = c.higher_is_better ? -c.change_pct : c.change_pct;
+      c.regression = worse > tolerance_pct;
+    }
+    out.push_back(c);
+  }
+  return out;
 }
 
 }  // namespace adit::pipeline

@@ -32,9 +32,19 @@ struct FigureChange {
   double change_pct = 0;    // (after - before) / before
   bool regression = false;  // worse by more than the tolerance
   bool missing = false;     // only in one of the two files
+  double change_min_pct = 0, change_max_pct = 0;  // over the pairs (compareFigurePairs; one pair: change_pct)
+  bool higher_is_better = false;                    // as BenchFigure's: which way is worse
 };
 
 std::vector<FigureChange> compareFigures(const std::vector<BenchFigure>& before, const std::vector<BenchFigure>& after,
                                          double tolerance_pct);
+
+// Runs of two builds taken in turn (before, after, before, after ...), pair i = before[i] and after[i]: a
+// machine whose speed drifts moves both runs of a pair alike, so each figure's change is the median of the
+// pairs' changes (with their range), its before and after the medians of each side. A figure of the first
+// pair that any run lacks is reported missing. Throws std::invalid_argument unless both sides have the same
+// number of runs (>= 1).
+std::vector<FigureChange> compareFigurePairs(const std::vector<std::vector<BenchFigure>>& before,
+                                             const std::vector<std::vector<BenchFigure>>& after, double tolerance_pct);
 
 }  // namespace adit::pipeline

@@ -222,29 +222,44 @@ void registerPipelineBench(CLI::App& bench) {
 
 void registerCompare(CLI::App& bench) {
   struct Args {
-    std::string before, after;
+    std::vector<std::string> files;
+    bool pairs = false;
     double tolerance_pct = 10.0;
   };
   auto a = std::make_shared<Args>();
-  auto* cmd = bench.add_subcommand("compare", "Compare two `adit bench pipeline --json` files, one line per figure; "
+  auto* cmd = bench.add_subcommand("compare", "Compare `adit bench pipeline --json` files, one line per figure; "
                                               "exit status 1 when a figure got worse by more than the tolerance");
-  cmd->add_option("before", a->before, "Figures of the reference build")->required()->check(CLI::ExistingFile);
-  cmd->add_option("after", a->after, "Figures of the build to judge")->required()->check(CLI::ExistingFile);
+  cmd->add_option("files", a->files,
+                  "BEFORE AFTER: the reference build's figures and the judged build's; with --pairs, runs of the "
+                  "two builds taken in turn: BEFORE AFTER BEFORE AFTER ...")
+      ->required()
+      ->check(CLI::ExistingFile);
+  cmd->add_flag("--pairs", a->pairs,
+                "Each figure's change is the median over the pairs (with its range): what a machine whose speed "
+                "drifts still tells apart (scripts/bench_pairs.sh takes such runs)");
   cmd->add_option("--tolerance", a->tolerance_pct, "Change in % beyond which a worse figure is a regression (default 10)")
       ->check(CLI::NonNegativeNumber);
   cmd->callback([a] {
-    const auto changes = adit::pipeline::compareFigures(adit::pipeline::readBenchFigures(a->before),
-                                                        adit::pipeline::readBenchFigures(a->after), a->tolerance_pct);
+    const std::size_t n = a->files.size();
+    if (n < 2 || n % 2 != 0 || (!a->pairs && n != 2))
+      throw CLI::ValidationError("files", a->pairs ? "--pairs takes BEFORE AFTER files in turn: an even number"
+                                                   : "two files, BEFORE and AFTER (several runs: --pairs)");
+    std::vector<std::vector<adit::pipeline::BenchFigure>> before, after;
+    for (std::size_t i = 0; i < n; ++i) (i % 2 ? after : before).push_back(adit::pipeline::readBenchFigures(a->files[i]));
+    const auto changes = adit::pipeline::compareFigurePairs(before, after, a->tolerance_pct);
     int regressions = 0;
     for (const auto& c : changes) {
       if (c.missing) {
-        fmt::print("  {:<32} only in {}\n", c.name, c.before == 0 && c.after != 0 ? a->after : a->before);
+        if (n == 2) fmt::print("  {:<36} only in {}\n", c.name, c.before == 0 && c.after != 0 ? a->files[1] : a->files[0]);
+        else fmt::print("  {:<36} missing from some of the files\n", c.name);
         continue;
       }
       regressions += c.regression ? 1 : 0;
-      fmt::print("  {:<32} {:>10.2f} -> {:>10.2f} {:<3} {:>+7.1f} %{}\n", c.name, c.before, c.after, c.unit, c.change_pct,
-                 c.regression ? "  REGRESSION" : "");
+      const std::string range = n > 2 ? fmt::format("  ({:+.1f} .. {:+.1f})", c.change_min_pct, c.change_max_pct) : "";
+      fmt::print("  {:<36} {:>10.2f} -> {:>10.2f} {:<3} {:>+7.1f} %{}{}\n", c.name, c.before, c.after, c.unit, c.change_pct,
+                 range, c.regression ? "  REGRESSION" : "");
     }
+    if (n > 2) fmt::print("{} pairs: medians of the pairs' changes\n", n / 2);
     fmt::print("{} regression(s) beyond {:.0f} %\n", regressions, a->tolerance_pct);
     if (regressions > 0) throw CLI::RuntimeError(1);
   });

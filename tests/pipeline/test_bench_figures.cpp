@@ -86,3 +86,32 @@ TEST(BenchFigures, ANonBenchmarkFileIsAClearError) {
   }
   std::filesystem::remove(path);
 }
+
+// Runs of two builds taken in turn on a machine whose speed drifts: each pair moves together, so the median of
+// the pairs' changes shows the builds' 10 % difference where the medians of each side alone (the machine
+// 1.0x, 1.6x, 1.2x slower over the three pairs) would mix drift into it; the range shows the spread.
+TEST(BenchFigures, PairedRunsJudgeTheMedianOfThePairsChanges) {
+  std::vector<std::vector<BenchFigure>> before, after;
+  for (const double machine : {1.0, 1.6, 1.2}) {
+    before.push_back(benchFigures(report(4.0 * machine, 1.0 * machine)));
+    after.push_back(benchFigures(report(4.4 * machine, 1.1 * machine)));
+  }
+  after[1] = benchFigures(report(4.0 * 1.6 * 1.3, 1.1 * 1.6));  // one noisy pair: +30 % CPU
+  const auto changes = compareFigurePairs(before, after, 20);
+  const FigureChange& cpu = change(changes, "feature.cpu_median_ms");
+  EXPECT_NEAR(cpu.change_pct, 10.0, 1e-9);  // median of +10, +30, +10
+  EXPECT_NEAR(cpu.change_min_pct, 10.0, 1e-9);
+  EXPECT_NEAR(cpu.change_max_pct, 30.0, 1e-9);
+  EXPECT_NEAR(cpu.before, 4.0 * 1.2, 1e-9);  // each side's median
+  EXPECT_FALSE(cpu.regression);              // 10 % within the 20 % tolerance, whatever one pair said
+  EXPECT_TRUE(change(compareFigurePairs(before, after, 5), "feature.cpu_median_ms").regression);
+  // The real-time factor is better higher: its median fall of ~9 % is judged as a fall.
+  const FigureChange& rt = change(compareFigurePairs(before, after, 5), "realtime_factor");
+  EXPECT_LT(rt.change_pct, -8.0);
+  EXPECT_TRUE(rt.regression);
+  // One pair is compareFigures itself; unequal sides are refused.
+  EXPECT_NEAR(change(compareFigurePairs({before[0]}, {after[0]}, 20), "feature.cpu_median_ms").change_pct,
+              change(compareFigures(before[0], after[0], 20), "feature.cpu_median_ms").change_pct, 1e-12);
+  EXPECT_THROW(compareFigurePairs(before, {after[0]}, 20), std::invalid_argument);
+  EXPECT_THROW(compareFigurePairs({}, {}, 20), std::invalid_argument);
+}
