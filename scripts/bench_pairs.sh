@@ -6,11 +6,12 @@
 # e.g. scripts/bench_pairs.sh /tmp/old/build/bin/adit build/bin/adit 6 -- --log run.lcmlog
 # Without arguments after --, each run is 20 s of simulated roadway-loop. Both builds read this checkout's
 # launch/config/pipeline.yaml unless the arguments give a --config. The JSON files stay in a temporary
-# folder whose name is printed; the exit status is adit bench compare's (1: a regression beyond 10 %).
+# folder whose name is printed; they are compared by this checkout's build/bin/adit (either build may be older
+# than --pairs); the exit status is adit bench compare's (1: a regression beyond 10 %).
 set -euo pipefail
 ROOT=$(cd "$(dirname "$0")/.." && pwd)
 if [ $# -lt 2 ]; then
-  sed -n '2,9p' "$0" | sed 's/^# \{0,1\}//'
+  sed -n '2,10p' "$0" | sed 's/^# \{0,1\}//'
   exit 2
 fi
 BEFORE=$1 AFTER=$2
@@ -34,4 +35,4 @@ for ((i = 1; i <= PAIRS; ++i)); do
   done
   echo "pair $i of $PAIRS done"
 done
-"$AFTER" bench compare --pairs "${FILES[@]}"
+"$ROOT/build/bin/adit" bench compare --pairs "${FILES[@]}"
