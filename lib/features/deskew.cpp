@@ -1,6 +1,5 @@
 #include "features/deskew.hpp"
 
-#include "core/chunk_pool.hpp"
 #include "core/geometry.hpp"
 
 #include <algorithm>
@@ -78,8 +77,7 @@ std::vector<Eigen::Quaterniond> imuRotations(const std::vector<ImuSample>& imu, 
 }
 
 std::int32_t deskewPoints(std::vector<LidarPoint>& points, std::int64_t utime, float sweep_duration,
-                          const std::vector<ImuSample>& imu, const MotionPrior& motion, const DeskewConfig& cfg,
-                          ChunkPool* pool) {
+                          const std::vector<ImuSample>& imu, const MotionPrior& motion, const DeskewConfig& cfg) {
   if (!cfg.enabled || points.empty()) return 0;
   const double sweep = std::max<double>(sweep_duration, 1e-3);
   const int steps = std::max(1, cfg.table_steps);
@@ -100,16 +98,11 @@ std::int32_t deskewPoints(std::vector<LidarPoint>& points, std::int64_t utime, f
   }
   // Linear interpolation between table poses 3 ms apart: the rotation matrices differ by ~1e-3 rad, so the
   // blend stays orthonormal to ~1e-6.
-  const auto move = [&](int, std::size_t begin, std::size_t end) {
-    for (std::size_t i = begin; i < end; ++i) {
-      LidarPoint& p = points[i];
-      const double u = std::clamp((p.dt + sweep) / sweep, 0.0, 1.0) * steps;
-      const int k = std::min(static_cast<int>(u), steps - 1);
-      p.p = blendedPose(R[k], R[k + 1], t[k], t[k + 1], static_cast<float>(u - k), p.p);
-    }
-  };
-  if (pool) pool->run(points.size(), pool->threads(), move);
-  else move(0, 0, points.size());
+  for (LidarPoint& p : points) {
+    const double u = std::clamp((p.dt + sweep) / sweep, 0.0, 1.0) * steps;
+    const int k = std::min(static_cast<int>(u), steps - 1);
+    p.p = blendedPose(R[k], R[k + 1], t[k], t[k + 1], static_cast<float>(u - k), p.p);
+  }
   return (imu_q.empty() ? 0 : FeatureSet::kDeskewImu) | (use_motion ? FeatureSet::kDeskewMotion : 0);
 }
 

@@ -10,8 +10,6 @@
 
 namespace adit {
 
-class ChunkPool;  // core/chunk_pool.hpp
-
 // Constant-velocity model from odometry: the motion over the previous interval, assumed to continue.
 struct MotionPrior {
   Eigen::Isometry3d T_prev_curr = Eigen::Isometry3d::Identity();  // lidar at previous sweep <- lidar now
@@ -35,10 +33,8 @@ std::vector<Eigen::Quaterniond> imuRotations(const std::vector<ImuSample>& imu, 
 // Deskews `points` in place (each uses its dt). Rotation from the IMU when its samples cover the sweep,
 // otherwise from the motion prior; translation from the motion prior when valid (an IMU alone gives none).
 // Returns the FeatureSet flags it applied: kDeskewImu and/or kDeskewMotion, 0 if points were not moved.
-// pool: the points are moved in ranges on its threads (each point alone: the same result for any count).
 std::int32_t deskewPoints(std::vector<LidarPoint>& points, std::int64_t utime, float sweep_duration,
-                          const std::vector<ImuSample>& imu, const MotionPrior& motion, const DeskewConfig& cfg,
-                          ChunkPool* pool = nullptr);
+                          const std::vector<ImuSample>& imu, const MotionPrior& motion, const DeskewConfig& cfg);
 
 }  // namespace features
 }  // namespace adit

@@ -44,7 +44,7 @@ FeatureSet FeatureExtractor::process(const LidarScan& scan, const std::vector<Im
   out.cloud = cloudHeader(scan);
 
   PreprocessReport rep;
-  RingCloud rings = preprocessScan(scan, cfg_.preprocess, &rep, pool_.get());
+  RingCloud rings = preprocessScan(scan, cfg_.preprocess, &rep);
   copyReport(rep, out);
   out.cloud.num_beams = rings.numRings();
   for (int r = 0; r < rings.numRings(); ++r)
@@ -55,7 +55,7 @@ FeatureSet FeatureExtractor::process(const LidarScan& scan, const std::vector<Im
   }
 
   if (!scan.deskewed) {
-    out.flags |= deskewPoints(rings.points, scan.utime, scan.sweep_duration, imu, motion, cfg_.deskew, pool_.get());
+    out.flags |= deskewPoints(rings.points, scan.utime, scan.sweep_duration, imu, motion, cfg_.deskew);
     out.cloud.deskewed = (out.flags & (FeatureSet::kDeskewImu | FeatureSet::kDeskewMotion)) != 0;
   }
 

@@ -1,6 +1,5 @@
 #include "features/preprocess.hpp"
 
-#include "core/chunk_pool.hpp"
 #include "features/voxel_centroids.hpp"
 
 #include <algorithm>
@@ -142,45 +141,36 @@ inline int neighboursWithin(const RingCloud& c, int i, int first, int last, int 
   return count;
 }
 
-// The radius test of ring r's points (see radiusInliers): keep[i] for each of them.
-void judgeRing(const RingCloud& c, int r, const PreprocessConfig& cfg, std::vector<char>& keep) {
-  int cursor[2] = {r > 0 ? c.ring_begin[r - 1] : 0, r + 1 < c.numRings() ? c.ring_begin[r + 1] : 0};
-  for (int i = c.ring_begin[r]; i < c.ring_begin[r + 1]; ++i) {
-    const float range = c.points[i].p.norm();
-    if (range >= cfg.outlier_max_range) continue;
-    const float radius = cfg.outlier_radius + cfg.outlier_radius_per_m * range;
-    const int need = cfg.outlier_min_neighbors;
-    int count = neighboursWithin(c, i, c.ring_begin[r], c.ring_begin[r + 1], i, cfg.outlier_window, radius * radius, need);
-    for (int side = 0; side < 2 && count < cfg.outlier_min_neighbors; ++side) {
-      const int adj = side == 0 ? r - 1 : r + 1;
-      if (adj < 0 || adj >= c.numRings() || c.ringSize(adj) == 0) continue;
-      int& k = cursor[side];  // last point of the adjacent ring fired no later than point i
-      while (k + 1 < c.ring_begin[adj + 1] && c.points[k + 1].dt <= c.points[i].dt) ++k;
-      count += neighboursWithin(c, i, c.ring_begin[adj], c.ring_begin[adj + 1], k, cfg.outlier_window,
-                                radius * radius, need - count);
-    }
-    keep[i] = count >= cfg.outlier_min_neighbors;
-  }
-}
-
 // Keeps a point if enough neighbours on its ring and the adjacent rings (at the same firing time) are near.
-// Each point's verdict reads the cloud only, so groups of rings may be judged on different threads.
-std::vector<char> radiusInliers(const RingCloud& c, const PreprocessConfig& cfg, ChunkPool* pool) {
+std::vector<char> radiusInliers(const RingCloud& c, const PreprocessConfig& cfg) {
   std::vector<char> keep(c.points.size(), 1);
   if (cfg.outlier_min_neighbors <= 0) return keep;
-  const auto judge = [&](int, std::size_t ring_begin, std::size_t ring_end) {
-    for (int r = static_cast<int>(ring_begin); r < static_cast<int>(ring_end); ++r) judgeRing(c, r, cfg, keep);
-  };
-  const auto rings = static_cast<std::size_t>(c.numRings());
-  if (pool) pool->run(rings, pool->threads(), judge);
-  else judge(0, 0, rings);
+  for (int r = 0; r < c.numRings(); ++r) {
+    int cursor[2] = {r > 0 ? c.ring_begin[r - 1] : 0, r + 1 < c.numRings() ? c.ring_begin[r + 1] : 0};
+    for (int i = c.ring_begin[r]; i < c.ring_begin[r + 1]; ++i) {
+      const float range = c.points[i].p.norm();
+      if (range >= cfg.outlier_max_range) continue;
+      const float radius = cfg.outlier_radius + cfg.outlier_radius_per_m * range;
+      const int need = cfg.outlier_min_neighbors;
+      int count = neighboursWithin(c, i, c.ring_begin[r], c.ring_begin[r + 1], i, cfg.outlier_window, radius * radius, need);
+      for (int side = 0; side < 2 && count < cfg.outlier_min_neighbors; ++side) {
+        const int adj = side == 0 ? r - 1 : r + 1;
+        if (adj < 0 || adj >= c.numRings() || c.ringSize(adj) == 0) continue;
+        int& k = cursor[side];  // last point of the adjacent ring fired no later than point i
+        while (k + 1 < c.ring_begin[adj + 1] && c.points[k + 1].dt <= c.points[i].dt) ++k;
+        count += neighboursWithin(c, i, c.ring_begin[adj], c.ring_begin[adj + 1], k, cfg.outlier_window,
+                                  radius * radius, need - count);
+      }
+      keep[i] = count >= cfg.outlier_min_neighbors;
+    }
+  }
   return keep;
 }
 
 // Drops the points the radius filter rejects, in place.
-void removeOutliers(RingCloud& c, const PreprocessConfig& cfg, PreprocessReport& rep, ChunkPool* pool) {
+void removeOutliers(RingCloud& c, const PreprocessConfig& cfg, PreprocessReport& rep) {
   if (cfg.outlier_min_neighbors <= 0) return;
-  const std::vector<char> keep = radiusInliers(c, cfg, pool);
+  const std::vector<char> keep = radiusInliers(c, cfg);
   std::size_t kept = 0;
   for (int r = 0; r < c.numRings(); ++r) {
     const int b = c.ring_begin[r], e = c.ring_begin[r + 1];
@@ -213,8 +203,7 @@ float timeFromAzimuth(const Eigen::Vector3f& p, float seam_azimuth, float sweep_
   return sweep_duration * (swept / kTwoPi - 1.0f);
 }
 
-RingCloud preprocessScan(const LidarScan& scan, const PreprocessConfig& cfg, PreprocessReport* report,
-                         ChunkPool* pool) {
+RingCloud preprocessScan(const LidarScan& scan, const PreprocessConfig& cfg, PreprocessReport* report) {
   PreprocessReport rep;
   rep.points_in = static_cast<int>(scan.points.size());
   rep.ring_derived = !scan.has_ring;
@@ -226,7 +215,7 @@ RingCloud preprocessScan(const LidarScan& scan, const PreprocessConfig& cfg, Pre
   std::vector<int> counts(static_cast<std::size_t>(num_rings) + 1, 0);
   assignRings(scan, cfg, num_rings, ring_of, counts, rep);
   RingCloud cloud = groupByRing(scan, ring_of, std::move(counts), seam_index, cfg.clockwise);
-  removeOutliers(cloud, cfg, rep, pool);
+  removeOutliers(cloud, cfg, rep);
   if (report) *report = rep;
   return cloud;
 }

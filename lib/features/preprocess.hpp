@@ -7,10 +7,6 @@
 
 #include <vector>
 
-namespace adit {
-class ChunkPool;  // core/chunk_pool.hpp
-}
-
 namespace adit::features {
 
 // More beams than any spinning lidar has; rings at or beyond this are dropped as out of range.
@@ -27,9 +23,7 @@ struct PreprocessReport {
 
 // The whole preprocessing chain: validity/range/body filter, ring and time assignment when missing,
 // grouping by ring in firing order, radius outlier removal. Never fails: an empty input gives an empty cloud.
-// pool: the outlier test runs on its threads, rings in groups (each point alone: the same result for any count).
-RingCloud preprocessScan(const LidarScan& scan, const PreprocessConfig& cfg, PreprocessReport* report,
-                         ChunkPool* pool = nullptr);
+RingCloud preprocessScan(const LidarScan& scan, const PreprocessConfig& cfg, PreprocessReport* report);
 
 // Ring index from elevation for scans without rings: num_rings equal bins over [min, max] elevation,
 // clamped at the ends (0 = lowest beam).

@@ -194,8 +194,7 @@ TEST(LoamFeatures, SectorCapsAndSuppressionLimitCounts) {
 
 // features.threads only spreads the work: every set, keypoint, descriptor, flag and the thinned sweep are the
 // same bytes for one thread or several (the rings' noise figure is a median, independent of how the rings
-// are grouped; the outlier test and the deskew judge and move each point alone), on a moving noisy sweep of
-// the pillar hall with dust, deskewed and not.
+// are grouped), on a moving noisy sweep of the pillar hall with dust, deskewed and not.
 TEST(FeatureExtractor, TheSameFeaturesForAnyThreadCount) {
   LidarScan scan = test::scanScene(test::pillarHall(), [](double t) {
     Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
