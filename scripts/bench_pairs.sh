@@ -3,7 +3,7 @@
 # within an hour): `adit bench pipeline` runs of the two builds taken in turn, before, after, before, after ...,
 # then `adit bench compare --pairs`, which judges each figure by the median of the pairs' changes.
 #   scripts/bench_pairs.sh BEFORE_ADIT AFTER_ADIT [PAIRS=5] [-- bench pipeline arguments]
-# e.g. scripts/bench_pairs.sh /tmp/old/build/bin/adit build/bin/adit 6 -- --log run.lcmlog
+# e.g. scripts/bench_pairs.sh ../adit-old/build/bin/adit build/bin/adit 6 -- --log run.lcmlog
 # Without arguments after --, each run is 20 s of simulated roadway-loop. Both builds read this checkout's
 # launch/config/pipeline.yaml unless the arguments give a --config. The JSON files stay in a temporary
 # folder whose name is printed; they are compared by this checkout's build/bin/adit (either build may be older
