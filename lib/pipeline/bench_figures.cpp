@@ -125,9 +125,15 @@ std::vector<FigureChange> compareFigurePairs(const std::vector<std::vector<Bench
                                             before.size(), after.size()));
   std::vector<std::vector<FigureChange>> pairs;
   for (std::size_t i = 0; i < before.size(); ++i) pairs.push_back(compareFigures(before[i], after[i], tolerance_pct));
+  // Every figure any pair has, in the order the pairs first name them.
+  std::vector<const FigureChange*> named;
+  for (const auto& pair : pairs)
+    for (const FigureChange& c : pair)
+      if (std::none_of(named.begin(), named.end(), [&](const FigureChange* n) { return n->name == c.name; }))
+        named.push_back(&c);
   std::vector<FigureChange> out;
-  for (const FigureChange& first : pairs.front()) {
-    FigureChange c = first;
+  for (const FigureChange* first : named) {
+    FigureChange c = *first;
     std::vector<double> befores, afters, changes;
     for (const auto& pair : pairs) {
       const auto it = std::find_if(pair.begin(), pair.end(), [&](const FigureChange& x) { return x.name == c.name; });

@@ -41,9 +41,8 @@ std::vector<FigureChange> compareFigures(const std::vector<BenchFigure>& before,
 
 // Runs of two builds taken in turn (before, after, before, after ...), pair i = before[i] and after[i]: a
 // machine whose speed drifts moves both runs of a pair alike, so each figure's change is the median of the
-// pairs' changes (with their range), its before and after the medians of each side. A figure of the first
-// pair that any run lacks is reported missing. Throws std::invalid_argument unless both sides have the same
-// number of runs (>= 1).
+// pairs' changes (with their range), its before and after the medians of each side. A figure that any run
+// lacks is reported missing. Throws std::invalid_argument unless both sides have the same number of runs (>= 1).
 std::vector<FigureChange> compareFigurePairs(const std::vector<std::vector<BenchFigure>>& before,
                                              const std::vector<std::vector<BenchFigure>>& after, double tolerance_pct);
 

@@ -113,5 +113,8 @@ TEST(BenchFigures, PairedRunsJudgeTheMedianOfThePairsChanges) {
   EXPECT_NEAR(change(compareFigurePairs({before[0]}, {after[0]}, 20), "feature.cpu_median_ms").change_pct,
               change(compareFigures(before[0], after[0], 20), "feature.cpu_median_ms").change_pct, 1e-12);
   EXPECT_THROW(compareFigurePairs(before, {after[0]}, 20), std::invalid_argument);
+  // A figure only a later run has is listed, as missing.
+  after[2].push_back({"only_later", 1.0, "ms", false});
+  EXPECT_TRUE(change(compareFigurePairs(before, after, 20), "only_later").missing);
   EXPECT_THROW(compareFigurePairs({}, {}, 20), std::invalid_argument);
 }
