@@ -21,7 +21,9 @@ if [ $# -gt 0 ] && [ "$1" != "--" ]; then PAIRS=$1; shift; fi
 [ $# -gt 0 ] && [ "$1" = "--" ] && shift
 ARGS=("$@")
 [ ${#ARGS[@]} -eq 0 ] && ARGS=(--sensor vlp16 --world roadway-loop --duration 20)
-printf '%s\n' "${ARGS[@]}" | grep -qx -- '--config' || ARGS+=(--config "$ROOT/launch/config/pipeline.yaml")
+HAS_CONFIG=0
+for arg in "${ARGS[@]}"; do [ "$arg" = --config ] && HAS_CONFIG=1; done
+[ $HAS_CONFIG = 1 ] || ARGS+=(--config "$ROOT/launch/config/pipeline.yaml")
 OUT=$(mktemp -d)
 echo "runs in $OUT"
 FILES=()

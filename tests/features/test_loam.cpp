@@ -204,7 +204,7 @@ TEST(FeatureExtractor, TheSameFeaturesForAnyThreadCount) {
   std::mt19937 rng(7);
   std::normal_distribution<float> noise(0.0f, 0.01f);
   for (LidarPoint& p : scan.points) p.p *= 1.0f + noise(rng) / p.p.norm();
-  // Dust: lone returns near the sensor that the radius outlier filter removes (its test runs in ring groups).
+  // Dust: lone returns near the sensor that the radius outlier filter removes (its counts are compared too).
   std::uniform_real_distribution<float> near(-3.0f, 3.0f);
   for (int i = 0; i < 40; ++i) {
     LidarPoint dust = scan.points[static_cast<std::size_t>(i) * scan.points.size() / 40];

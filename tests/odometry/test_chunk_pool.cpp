@@ -216,7 +216,7 @@ TEST(ParallelMatching, AResetOdometryDropsTheBuildInFlight) {
   odom.process(sweeps[1]);  // its index is being built
   odom.reset();
   for (std::size_t i = 0; i < sweeps.size(); ++i) EXPECT_TRUE(sameBytes(expected[i], odom.process(sweeps[i]))) << i;
-  EXPECT_GT(odom.helperCpuMs(), 0.0);  // the builds' CPU, counted on the builder thread
+  EXPECT_GT(odom.helperCpuMs(), 0.0);  // the search threads' and the builder's CPU since the reset
   {
     ScanToScanOdometry short_lived(oc);
     short_lived.process(sweeps[0]);
